@@ -1,0 +1,1 @@
+"""Simulator scenarios, one YAML file each."""

@@ -1,0 +1,88 @@
+"""Planar rigid-body poses (SE(2)) in metres and radians."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def wrap_angle(angle):
+    """Wrap an angle (or array of angles) in radians to [-pi, pi)."""
+    return (np.asarray(angle) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Rotation about z of the quaternion (x, y, z, w), radians.
+
+    This is the heading of the rotated frame's x axis projected on the xy plane, which is
+    exact for the planar robots this tracker serves.
+    """
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+@dataclass(frozen=True)
+class Pose2D:
+    """Pose of a child frame in a parent frame: translation (m) and heading (rad).
+
+    ``parent_T_child`` maps points in the child frame to the parent frame:
+    ``p_parent = R(yaw) p_child + (x, y)``.
+    """
+
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
+
+    @staticmethod
+    def identity() -> "Pose2D":
+        return Pose2D(0.0, 0.0, 0.0)
+
+    def compose(self, other: "Pose2D") -> "Pose2D":
+        """``self ∘ other``: a_T_c from self = a_T_b and other = b_T_c."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        # t_ac = R_ab t_bc + t_ab ; yaw_ac = yaw_ab + yaw_bc
+        return Pose2D(
+            self.x + c * other.x - s * other.y,
+            self.y + s * other.x + c * other.y,
+            float(wrap_angle(self.yaw + other.yaw)),
+        )
+
+    def __matmul__(self, other: "Pose2D") -> "Pose2D":
+        return self.compose(other)
+
+    def inverse(self) -> "Pose2D":
+        """b_T_a from self = a_T_b."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        # t_ba = -R_abᵀ t_ab
+        return Pose2D(-(c * self.x + s * self.y), -(-s * self.x + c * self.y), float(wrap_angle(-self.yaw)))
+
+    def between(self, other: "Pose2D") -> "Pose2D":
+        """Relative pose self⁻¹ ∘ other: where ``other`` is, seen from ``self``."""
+        return self.inverse().compose(other)
+
+    def transform_points(self, points: np.ndarray) -> np.ndarray:
+        """Map points (n, 2) from the child frame to the parent frame, metres."""
+        pts = np.asarray(points, dtype=np.float64)
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        rot = np.array([[c, -s], [s, c]])
+        # p_parent = R p_childᵀ + t
+        return pts @ rot.T + np.array([self.x, self.y])
+
+    def as_matrix(self) -> np.ndarray:
+        """Homogeneous 3x3 matrix of this pose."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return np.array([[c, -s, self.x], [s, c, self.y], [0.0, 0.0, 1.0]])
+
+
+def interpolate_pose(p0: Pose2D, p1: Pose2D, fraction: float) -> Pose2D:
+    """Pose a ``fraction`` of the way from p0 to p1 (0 → p0, 1 → p1; beyond extrapolates).
+
+    Translation is linear and heading follows the shorter arc.
+    """
+    dyaw = float(wrap_angle(p1.yaw - p0.yaw))
+    return Pose2D(
+        p0.x + fraction * (p1.x - p0.x),
+        p0.y + fraction * (p1.y - p0.y),
+        float(wrap_angle(p0.yaw + fraction * dyaw)),
+    )

@@ -1,0 +1,114 @@
+"""The laser scan: what a planar laser scanner gives, in its own sensor frame."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class Scan:
+    """One sweep of a planar laser scanner (ROS ``sensor_msgs/LaserScan`` semantics).
+
+    Beam ``i`` points at ``angle_min + i * angle_increment`` radians in the sensor frame
+    (REP 103: x forward, y left, counter-clockwise positive). The increment may be
+    negative: some scanners count clockwise.
+
+    Parameters
+    ----------
+    ranges : ndarray, shape (n,)
+        Measured range of each beam, metres. May hold ``nan``, ``inf`` and ``0``;
+        see :attr:`valid`. Stored as a read-only float64 copy.
+    angle_min : float
+        Bearing of beam 0 in the sensor frame, radians.
+    angle_increment : float
+        Bearing step between consecutive beams, radians; non-zero, may be negative.
+    range_min, range_max : float
+        Limits of a trustworthy reading, metres.
+    stamp : float
+        Acquisition time of beam 0 (the header stamp), seconds.
+    frame_id : str
+        Name of the sensor frame, without a leading ``/``.
+    time_increment : float
+        Time between consecutive beams, seconds (0 when unknown).
+    """
+
+    ranges: np.ndarray
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    stamp: float
+    frame_id: str = "laser"
+    time_increment: float = 0.0
+
+    def __post_init__(self) -> None:
+        ranges = np.array(self.ranges, dtype=np.float64)  # always a private copy
+        if ranges.ndim != 1:
+            raise ValueError(f"ranges must be one-dimensional, got shape {ranges.shape}")
+        if not np.isfinite(self.angle_increment) or self.angle_increment == 0.0:
+            raise ValueError(f"angle_increment must be finite and non-zero, got {self.angle_increment}")
+        ranges.setflags(write=False)
+        object.__setattr__(self, "ranges", ranges)
+        object.__setattr__(self, "frame_id", str(self.frame_id).lstrip("/"))
+
+    @property
+    def n_beams(self) -> int:
+        """Number of beams, valid or not."""
+        return int(self.ranges.shape[0])
+
+    @cached_property
+    def valid(self) -> np.ndarray:
+        """Boolean mask, shape (n,): finite and strictly between range_min and range_max."""
+        r = self.ranges
+        with np.errstate(invalid="ignore"):
+            mask = np.isfinite(r) & (r > self.range_min) & (r < self.range_max)
+        mask.setflags(write=False)
+        return mask
+
+    @property
+    def n_valid(self) -> int:
+        """Number of valid readings."""
+        return int(np.count_nonzero(self.valid))
+
+    @cached_property
+    def angles(self) -> np.ndarray:
+        """Bearing of every beam in the sensor frame, radians, shape (n,)."""
+        a = self.angle_min + np.arange(self.n_beams, dtype=np.float64) * self.angle_increment
+        a.setflags(write=False)
+        return a
+
+    @property
+    def angle_max(self) -> float:
+        """Bearing of the last beam, radians (below ``angle_min`` when counting clockwise)."""
+        return self.angle_min + (self.n_beams - 1) * self.angle_increment
+
+    @property
+    def resolution(self) -> float:
+        """Angular resolution ``|angle_increment|``, radians."""
+        return abs(self.angle_increment)
+
+    @cached_property
+    def points(self) -> np.ndarray:
+        """Cartesian reading of every beam in the sensor frame, metres, shape (n, 2).
+
+        Rows of invalid beams are ``nan``; index with :attr:`valid` for the usable ones.
+        """
+        r = np.where(self.valid, self.ranges, np.nan)
+        xy = np.empty((self.n_beams, 2))
+        np.multiply(r, np.cos(self.angles), out=xy[:, 0])
+        np.multiply(r, np.sin(self.angles), out=xy[:, 1])
+        xy.setflags(write=False)
+        return xy
+
+    @property
+    def valid_points(self) -> np.ndarray:
+        """Cartesian readings of the valid beams only, sensor frame, metres, shape (m, 2)."""
+        return self.points[self.valid]
+
+    @property
+    def beam_times(self) -> np.ndarray:
+        """Firing time of every beam relative to :attr:`stamp`, seconds, shape (n,)."""
+        return np.arange(self.n_beams, dtype=np.float64) * self.time_increment

@@ -1,0 +1,165 @@
+"""The ``people-tracker`` command line.
+
+Every bad input file or configuration ends with one line on stderr and exit status 2;
+bad scans inside a good recording give one warning each and the run goes on.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+from tracker.errors import InputError
+
+PROG = "people-tracker"
+
+
+class _CliError(Exception):
+    """A usage error found by argparse."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, exit 2, no usage dump
+        raise _CliError(message)
+
+
+class _TqdmHandler(logging.Handler):
+    """Warnings on stderr, one line each, written around a live progress bar."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            from tqdm import tqdm
+            tqdm.write(f"{PROG}: warning: {record.getMessage()}", file=sys.stderr)
+        except Exception:  # pragma: no cover - logging must never raise
+            self.handleError(record)
+
+
+def _setup_logging(quiet: bool) -> None:
+    root = logging.getLogger()
+    root.handlers[:] = [_TqdmHandler()]
+    root.setLevel(logging.ERROR if quiet else logging.WARNING)
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog=PROG, description="Find and follow walking people in 2D laser scans.")
+    p.add_argument("-q", "--quiet", action="store_true", help="no warnings, no progress bar")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+
+    run = sub.add_parser("run", help="run on a recording (or the built-in simulated scene)")
+    run.add_argument("input", nargs="?", metavar="INPUT",
+                     help="a ROS 1 .bag, a ROS 2 bag folder, or an .mcap file")
+    run.add_argument("--topic", help="LaserScan topic (default: the only one)")
+    run.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
+
+    ev = sub.add_parser("evaluate", help="score a tracks CSV against ground truth")
+    ev.add_argument("tracks", metavar="TRACKS.csv")
+    ev.add_argument("--ground-truth", required=True, metavar="BAG|GT.csv")
+
+    sim = sub.add_parser("simulate", help="render a simulated scenario to a ROS 2 bag")
+    sim.add_argument("scenario", metavar="SCENARIO")
+    sim.add_argument("--output", required=True, metavar="OUT")
+    return p
+
+
+def _progress(total: int, quiet: bool):
+    from tqdm import tqdm
+    # disable=None: only on a terminal; delay: only for runs over a few seconds
+    return tqdm(total=total, unit="scan", file=sys.stderr, disable=True if quiet else None,
+                delay=2.0, leave=False, dynamic_ncols=True)
+
+
+def _cmd_run(args) -> int:
+    from tracker.config import load_config
+    from tracker.io.recording import Recording
+    from tracker.scan_checks import ScanChecker
+
+    if args.input is None:
+        raise InputError("the built-in simulated scene is not available yet (it arrives with the simulator); "
+                         "give a recording: people-tracker run FILE.bag")
+    config = load_config(args.config)
+    log = logging.getLogger(PROG)
+    t0 = time.perf_counter()
+    with Recording(args.input, args.topic, config.odometry) as rec:
+        checker = ScanChecker(config.scan_checks.stamp_jump_periods, config.scan_checks.beam_count_confirm)
+        used = skipped = restarts = with_pose = 0
+        first_stamp = last_stamp = None
+        path_m = 0.0
+        last_pose = None
+        with _progress(rec.scan_count, args.quiet) as bar:
+            for record in rec.scans():
+                bar.update(1)
+                verdict = checker.check(record.scan, record.problem)
+                if verdict.reason:
+                    log.warning("scan %d %s", record.index, verdict.reason)
+                if not verdict.use:
+                    skipped += 1
+                    continue
+                used += 1
+                restarts += verdict.restart
+                scan = record.scan
+                first_stamp = scan.stamp if first_stamp is None else first_stamp
+                last_stamp = scan.stamp
+                if record.pose is not None:
+                    with_pose += 1
+                    if last_pose is not None:
+                        path_m += math.hypot(record.pose.x - last_pose.x, record.pose.y - last_pose.y)
+                    last_pose = record.pose
+        elapsed = time.perf_counter() - t0
+        span = (last_stamp - first_stamp) if used > 1 else 0.0
+        rate = f", {(used - 1) / span:.1f} Hz" if span > 0 else ""
+        print(f"input: {rec.path} topic {rec.topic} (frame {rec.laser_frame}, {rec.n_beams} beams{rate})")
+        if rec.fixed_frame is None:
+            print("odometry: none (scans are compared without a pose prior)")
+        else:
+            print(f"odometry: {rec.odometry}; fixed frame {rec.fixed_frame}; "
+                  f"{with_pose} of {used} scans posed; sensor travelled {path_m:.1f} m")
+        total = used + skipped
+        print(f"scans: {total} read, {used} used, {skipped} skipped, {restarts} history restarts; "
+              f"{span:.1f} s of recording in {elapsed:.2f} s ({total / max(elapsed, 1e-9):.0f} scans/s)")
+    return 0
+
+
+def _cmd_evaluate(args) -> int:
+    raise InputError("evaluate is not available yet (it arrives with the evaluation issue)")
+
+
+def _cmd_simulate(args) -> int:
+    raise InputError("simulate is not available yet (it arrives with the simulator)")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``people-tracker`` console script; returns the exit status."""
+    argv = sys.argv[1:] if argv is None else argv
+    try:
+        args = _build_parser().parse_args(argv)
+    except _CliError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    _setup_logging(args.quiet)
+    commands = {"run": _cmd_run, "evaluate": _cmd_evaluate, "simulate": _cmd_simulate}
+    try:
+        return commands[args.command](args)
+    except InputError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0
+    except Exception as exc:  # never a traceback for users; PEOPLE_TRACKER_DEBUG=1 shows it
+        if os.environ.get("PEOPLE_TRACKER_DEBUG"):
+            raise
+        print(f"{PROG}: internal error: {type(exc).__name__}: {' '.join(str(exc).split())[:300]} "
+              f"(set PEOPLE_TRACKER_DEBUG=1 for the traceback)", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,169 @@
+"""Configuration: YAML → frozen dataclasses, every key checked.
+
+``configs/default.yaml`` (shipped in the wheel) holds every tunable and its unit; a user
+file given with ``--config`` overrides any subset of it. Unknown keys, wrong types and
+out-of-range values raise :class:`~tracker.errors.InputError` naming the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import typing
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from tracker.errors import InputError
+
+
+def _spec(*, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
+          choices: tuple[str, ...] | None = None) -> dict:
+    return {"lo": lo, "hi": hi, "lo_open": lo_open, "choices": choices}
+
+
+@dataclass(frozen=True)
+class OdometryConfig:
+    """Where the sensor pose in the fixed frame comes from, and how it is interpolated."""
+
+    source: str = field(metadata=_spec(choices=("auto", "odom", "tf", "none")))
+    odom_topic: str = field(metadata=_spec())
+    tf_discovery_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3600.0))
+    max_wait_s: float = field(metadata=_spec(lo=0.0, hi=60.0))
+    max_interpolation_gap_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=60.0))
+    max_extrapolation_s: float = field(metadata=_spec(lo=0.0, hi=10.0))
+
+
+@dataclass(frozen=True)
+class ScanChecksConfig:
+    """Rules for bad scans inside a good recording."""
+
+    stamp_jump_periods: float = field(metadata=_spec(lo=1.0, lo_open=True, hi=1e6))
+    beam_count_confirm: int = field(metadata=_spec(lo=1, hi=1000))
+
+
+@dataclass(frozen=True)
+class Config:
+    """The whole resolved configuration."""
+
+    odometry: OdometryConfig
+    scan_checks: ScanChecksConfig
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def _default_text() -> str:
+    return resources.files("configs").joinpath("default.yaml").read_text(encoding="utf-8")
+
+
+def _merge(base: dict, override: dict, where: str) -> dict:
+    out = dict(base)
+    for key, value in override.items():
+        name = f"{where}{key}"
+        if key not in base:
+            raise InputError(f"unknown configuration key '{name}' (known: {', '.join(sorted(base))})")
+        if isinstance(base[key], dict):
+            if not isinstance(value, dict):
+                raise InputError(f"configuration key '{name}' must be a mapping of its keys")
+            out[key] = _merge(base[key], value, f"{name}.")
+        else:
+            out[key] = value
+    return out
+
+
+def _check_value(name: str, value: Any, typ: type, spec: dict) -> Any:
+    if typ is bool:
+        if not isinstance(value, bool):
+            raise InputError(f"configuration key '{name}' must be true or false, got {value!r}")
+        return value
+    if typ is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise InputError(f"configuration key '{name}' must be a whole number, got {value!r}")
+    elif typ is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise InputError(f"configuration key '{name}' must be a number, got {value!r}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise InputError(f"configuration key '{name}' must be finite, got {value!r}")
+    elif typ is str:
+        if not isinstance(value, str):
+            raise InputError(f"configuration key '{name}' must be a string, got {value!r}")
+        if spec["choices"] and value not in spec["choices"]:
+            raise InputError(
+                f"configuration key '{name}' must be one of {', '.join(spec['choices'])}; got {value!r}"
+            )
+        return value
+    lo, hi = spec["lo"], spec["hi"]
+    if lo is not None and (value < lo or (spec["lo_open"] and value == lo)):
+        rel = ">" if spec["lo_open"] else ">="
+        raise InputError(f"configuration key '{name}' must be {rel} {lo}, got {value!r}")
+    if hi is not None and value > hi:
+        raise InputError(f"configuration key '{name}' must be <= {hi}, got {value!r}")
+    return value
+
+
+def _build(cls: type, data: dict, where: str):
+    hints = typing.get_type_hints(cls)
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        name = f"{where}{f.name}"
+        if f.name not in data:
+            raise InputError(f"configuration key '{name}' is missing")
+        typ = hints[f.name]
+        if dataclasses.is_dataclass(typ):
+            if not isinstance(data[f.name], dict):
+                raise InputError(f"configuration key '{name}' must be a mapping of its keys")
+            kwargs[f.name] = _build(typ, data[f.name], f"{name}.")
+        else:
+            kwargs[f.name] = _check_value(name, data[f.name], typ, f.metadata)
+    return cls(**kwargs)
+
+
+def _parse_yaml(text: str, origin: str) -> dict:
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        at = f" at line {mark.line + 1}" if mark is not None else ""
+        raise InputError(f"configuration {origin} is not valid YAML{at}") from None
+    if data is None:
+        raise InputError(f"configuration {origin} is empty")
+    if not isinstance(data, dict):
+        raise InputError(f"configuration {origin} must be a mapping of sections, got {type(data).__name__}")
+    return data
+
+
+def default_config_dict() -> dict:
+    """The shipped defaults as a plain nested dict."""
+    return _parse_yaml(_default_text(), "default.yaml")
+
+
+def config_from_dict(overrides: dict | None = None) -> Config:
+    """Build a :class:`Config` from the defaults with ``overrides`` (a nested dict) applied."""
+    merged = _merge(default_config_dict(), overrides or {}, "")
+    return _build(Config, merged, "")
+
+
+def load_config(path: str | Path | None = None) -> Config:
+    """Load the defaults, overridden by the YAML file at ``path`` when given."""
+    if path is None:
+        return config_from_dict()
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"configuration file '{p}' does not exist")
+    if p.is_dir():
+        raise InputError(f"configuration file '{p}' is a directory")
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"configuration file '{p}' cannot be read: {exc}") from None
+    return config_from_dict(_parse_yaml(text, f"file '{p}'"))
+
+
+def dump_config(config: Config) -> str:
+    """YAML text of the resolved configuration (written next to every output)."""
+    return yaml.safe_dump(config.to_dict(), sort_keys=False)
