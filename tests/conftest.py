@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import os
-import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+
+# helpers shared by the tests (tests/tests_helpers); only tests/ goes on the path, so the
+# package under test is still the installed one
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("PEOPLE_TRACKER_DATA", REPO.parent / "shared" / "data"))
@@ -30,10 +32,3 @@ def moving_bag() -> Path:
 @pytest.fixture
 def negative_bag() -> Path:
     return data_file("leigh/negative_2.bag")
-
-
-def run_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    """Run the installed ``people-tracker`` command as a user would."""
-    exe = shutil.which("people-tracker", path=str(Path(sys.executable).parent)) or shutil.which("people-tracker")
-    cmd = [exe] if exe else [sys.executable, "-m", "tracker"]
-    return subprocess.run(cmd + list(args), capture_output=True, text=True, cwd=cwd, timeout=300)

@@ -14,7 +14,7 @@ import numpy as np
 from rosbags.rosbag1 import Writer as Writer1
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Writer2
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from models.pose import Pose2D
 from models.scan import Scan
@@ -43,6 +43,8 @@ class BagWriter:
             raise InputError(f"output '{self.path}' exists already")
         self._ros1 = fmt == "ros1"
         self._ts = get_typestore(Stores.ROS1_NOETIC if self._ros1 else Stores.ROS2_HUMBLE)
+        if TF_MESSAGE not in self._ts.types:  # the ROS 1 store lacks tf2_msgs; same definition as ROS 2
+            self._ts.register(get_types_from_msg("geometry_msgs/TransformStamped[] transforms", TF_MESSAGE))
         if self._ros1:
             self._writer = Writer1(self.path)
         else:

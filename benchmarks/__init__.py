@@ -1,0 +1,1 @@
+"""Speed and accuracy scripts; `people-tracker bench` builds on them."""

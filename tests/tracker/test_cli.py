@@ -1,0 +1,128 @@
+"""The command line as users meet it: bad inputs give one line and exit 2, never a traceback."""
+
+import shutil
+
+import pytest
+
+from tests_helpers import bagmaker, run_cli
+from conftest import data_file
+
+
+def assert_one_line_error(proc, *words):
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert "Traceback" not in proc.stderr and lines[0].startswith("people-tracker: error: ")
+    for w in words:
+        assert w in lines[0], lines[0]
+    assert proc.stdout == ""
+
+
+@pytest.fixture(scope="module")
+def good_bag(tmp_path_factory):
+    p = tmp_path_factory.mktemp("bags") / "good"
+    bagmaker.write_bag(p, "mcap", n_scans=10)
+    return p
+
+
+def test_missing_input(tmp_path):
+    assert_one_line_error(run_cli("run", str(tmp_path / "nope.bag")), "does not exist")
+
+
+def test_empty_input(tmp_path):
+    (tmp_path / "empty.bag").write_bytes(b"")
+    assert_one_line_error(run_cli("run", str(tmp_path / "empty.bag")), "is empty")
+
+
+@pytest.mark.parametrize("name", ["junk.bag", "junk.mcap"])
+def test_corrupt_input(tmp_path, name):
+    (tmp_path / name).write_bytes(b"\x00garbage" * 1000)
+    assert_one_line_error(run_cli("run", str(tmp_path / name)), "cannot be read")
+
+
+def test_truncated_real_recording(tmp_path):
+    src = data_file("leigh/positive_1.bag")
+    (tmp_path / "cut.bag").write_bytes(src.read_bytes()[: 300_000])
+    assert_one_line_error(run_cli("run", str(tmp_path / "cut.bag")), "cut.bag")
+
+
+def test_not_a_recording(tmp_path):
+    (tmp_path / "notes.txt").write_text("hello")
+    assert_one_line_error(run_cli("run", str(tmp_path / "notes.txt")), "not a ROS 1 .bag")
+    assert_one_line_error(run_cli("run", str(tmp_path)), "no metadata.yaml")
+
+
+def test_no_laser_scan_topic(tmp_path):
+    from tracker.io.bag_writer import BagWriter
+    from models.pose import Pose2D
+    with BagWriter(tmp_path / "odom_only", "mcap") as w:
+        w.write_odometry("/odom", 1.0, "odom", "base_link", Pose2D())
+    assert_one_line_error(run_cli("run", str(tmp_path / "odom_only")), "no LaserScan topic", "/odom")
+
+
+def test_several_topics_and_none_chosen(negative_bag):
+    assert_one_line_error(run_cli("run", str(negative_bag)), "/left_scan", "/rear_scan", "/right_scan", "--topic")
+
+
+def test_wrong_topic(good_bag):
+    assert_one_line_error(run_cli("run", str(good_bag), "--topic", "/laser"), "no topic '/laser'", "/scan")
+    assert_one_line_error(run_cli("run", str(good_bag), "--topic", "/odom"), "not a LaserScan topic")
+
+
+@pytest.mark.parametrize("text,words", [
+    ("odometry:\n  speed: 3\n", "'odometry.speed'"),
+    ("odometry:\n  max_wait_s: -2\n", "'odometry.max_wait_s'"),
+    ("odometry: [\n", "not valid YAML"),
+    ("", "empty"),
+])
+def test_bad_config(tmp_path, good_bag, text, words):
+    (tmp_path / "c.yaml").write_text(text)
+    assert_one_line_error(run_cli("run", str(good_bag), "--config", str(tmp_path / "c.yaml")), words)
+
+
+def test_missing_config(tmp_path, good_bag):
+    assert_one_line_error(run_cli("run", str(good_bag), "--config", str(tmp_path / "no.yaml")), "does not exist")
+
+
+def test_bad_usage():
+    assert_one_line_error(run_cli("dance"), "invalid choice")
+    assert_one_line_error(run_cli("run", "--bogus"), "unrecognized arguments")
+
+
+def test_run_on_a_good_recording_summarises_it(good_bag):
+    proc = run_cli("run", str(good_bag))
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr == ""
+    assert "10 read, 10 used, 0 skipped" in proc.stdout and "fixed frame odom" in proc.stdout
+
+
+def test_bad_scans_inside_a_good_recording_warn_once_each_and_keep_their_index(tmp_path):
+    import numpy as np
+    scans = [bagmaker.make_scan(i) for i in range(12)]
+    scans[3] = bagmaker.make_scan(3, ranges=np.full(360, np.nan))  # all invalid
+    scans[6] = bagmaker.make_scan(6, stamp=scans[4].stamp)  # stamp goes backwards
+    scans[8] = bagmaker.make_scan(8, n=180)  # changed beam count
+    scans[10] = bagmaker.make_scan(10, stamp=scans[9].stamp + 5.0)  # a jump
+    scans[11] = bagmaker.make_scan(11, stamp=scans[10].stamp + 0.1)
+    bagmaker.write_bag(tmp_path / "bad", "mcap", scans=scans)
+    proc = run_cli("run", str(tmp_path / "bad"))
+    assert proc.returncode == 0, proc.stderr
+    warnings = proc.stderr.strip().splitlines()
+    assert len(warnings) == 4 and all(w.startswith("people-tracker: warning: scan ") for w in warnings)
+    for idx, words in ((3, "invalid"), (6, "goes back"), (8, "180 beams"), (10, "jumps")):
+        assert any(w.startswith(f"people-tracker: warning: scan {idx} ") and words in w for w in warnings), warnings
+    assert "12 read, 9 used, 3 skipped, 1 history restarts" in proc.stdout
+
+
+def test_run_without_input_says_the_scene_is_not_there_yet():
+    proc = run_cli("run")
+    assert_one_line_error(proc, "simulated scene")
+
+
+def test_console_script_is_installed_beside_the_interpreter():
+    import sys
+    from pathlib import Path
+    exe = shutil.which("people-tracker", path=str(Path(sys.executable).parent))
+    assert exe is not None, "pip install did not put people-tracker next to python"
+    proc = run_cli("--help")
+    assert proc.returncode == 0 and "run" in proc.stdout and "evaluate" in proc.stdout and "simulate" in proc.stdout

@@ -1,0 +1,60 @@
+import re
+from importlib import resources
+
+import pytest
+
+from tracker.config import Config, config_from_dict, dump_config, load_config
+from tracker.errors import InputError
+
+
+def test_defaults_load_into_frozen_dataclasses():
+    cfg = load_config()
+    assert isinstance(cfg, Config) and cfg.odometry.source == "auto"
+    with pytest.raises(Exception):
+        cfg.odometry.source = "tf"
+
+
+def test_default_yaml_ships_with_the_package_and_every_tunable_has_a_unit_comment():
+    text = resources.files("configs").joinpath("default.yaml").read_text()
+    leaves = [ln for ln in text.splitlines() if re.match(r"^\s+\w+:\s*\S", ln)]
+    assert leaves, "no tunables found"
+    for line in leaves:
+        assert "#" in line and len(line.split("#", 1)[1].strip()) > 5, f"no unit/explanation: {line!r}"
+
+
+def test_override_file_changes_only_its_keys(tmp_path):
+    f = tmp_path / "c.yaml"
+    f.write_text("odometry:\n  max_wait_s: 2\n")
+    cfg = load_config(f)
+    assert cfg.odometry.max_wait_s == 2.0 and cfg.odometry.source == "auto"
+    assert "max_wait_s: 2.0" in dump_config(cfg)
+
+
+@pytest.mark.parametrize("override,key", [
+    ({"odometry": {"bogus": 1}}, "odometry.bogus"),
+    ({"nonsense": {}}, "nonsense"),
+    ({"odometry": {"max_wait_s": -1}}, "odometry.max_wait_s"),
+    ({"odometry": {"max_interpolation_gap_s": 0}}, "odometry.max_interpolation_gap_s"),
+    ({"odometry": {"source": "gps"}}, "odometry.source"),
+    ({"odometry": {"max_wait_s": "soon"}}, "odometry.max_wait_s"),
+    ({"scan_checks": {"beam_count_confirm": 2.5}}, "scan_checks.beam_count_confirm"),
+    ({"scan_checks": {"stamp_jump_periods": float("nan")}}, "scan_checks.stamp_jump_periods"),
+    ({"odometry": 3}, "odometry"),
+])
+def test_bad_values_name_the_key(override, key):
+    with pytest.raises(InputError) as err:
+        config_from_dict(override)
+    assert f"'{key}'" in str(err.value)
+
+
+@pytest.mark.parametrize("text,words", [("", "empty"), ("odometry: [1, 2\n", "not valid YAML"), ("- 1\n- 2\n", "mapping")])
+def test_bad_files(tmp_path, text, words):
+    f = tmp_path / "c.yaml"
+    f.write_text(text)
+    with pytest.raises(InputError, match=words):
+        load_config(f)
+
+
+def test_missing_file():
+    with pytest.raises(InputError, match="does not exist"):
+        load_config("/no/such/config.yaml")
