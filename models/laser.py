@@ -1,0 +1,126 @@
+"""The laser model of the simulator: geometry, timing and noise of a planar scanner."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from models.pose import Pose2D
+from models.raycast import cast_rays
+from models.scan import Scan
+
+
+@dataclass(frozen=True)
+class LaserModel:
+    """A planar laser scanner.
+
+    Attributes
+    ----------
+    fov : float
+        Field of view, radians, centred on the sensor's x axis.
+    resolution : float
+        Angle between beams, radians (> 0).
+    rate_hz : float
+        Scans per second.
+    range_min, range_max : float
+        Metres; readings outside are reported as ``range_max + 1`` (out of range).
+    noise_std : float
+        Standard deviation of the Gaussian range noise, metres.
+    dropout : float
+        Probability that a reading is lost, reported as ``dropout_value``.
+    dropout_value : float
+        ``nan`` or ``0.0``, as different drivers report a lost reading.
+    clockwise : bool
+        Beams counted clockwise (negative ``angle_increment``).
+    frame_id : str
+        Name of the sensor frame.
+    sweep_fraction : float
+        Share of the scan period spent sweeping the beams (sets ``time_increment``):
+        a spinning 270° scanner sweeps 270/360 of its period.
+    """
+
+    fov: float = math.radians(270.0)
+    resolution: float = math.radians(0.35)
+    rate_hz: float = 10.0
+    range_min: float = 0.05
+    range_max: float = 20.0
+    noise_std: float = 0.01
+    dropout: float = 0.0
+    dropout_value: float = float("nan")
+    clockwise: bool = False
+    frame_id: str = "laser"
+    sweep_fraction: float = 0.75
+
+    @property
+    def n_beams(self) -> int:
+        return int(round(self.fov / self.resolution)) + 1
+
+    @property
+    def angle_min(self) -> float:
+        """Bearing of beam 0, radians (the right edge, or the left one when clockwise)."""
+        return self.fov / 2.0 if self.clockwise else -self.fov / 2.0
+
+    @property
+    def angle_increment(self) -> float:
+        step = self.fov / (self.n_beams - 1)
+        return -step if self.clockwise else step
+
+    @property
+    def period(self) -> float:
+        return 1.0 / self.rate_hz
+
+    @property
+    def time_increment(self) -> float:
+        return self.period * self.sweep_fraction / max(self.n_beams - 1, 1)
+
+    def beam_angles(self) -> np.ndarray:
+        return self.angle_min + np.arange(self.n_beams) * self.angle_increment
+
+    def render(self, stamp: float, sensor_poses: list[Pose2D] | Pose2D, segments: np.ndarray,
+               circles: np.ndarray, rng: np.random.Generator | None = None) -> tuple[Scan, np.ndarray]:
+        """Render one scan.
+
+        Parameters
+        ----------
+        stamp : float
+            Time of beam 0, seconds.
+        sensor_poses : Pose2D or sequence of Pose2D
+            Sensor pose in the world frame; one pose, or one for each beam (a moving sensor
+            fires each beam from where it is at that instant).
+        segments, circles : ndarray
+            The scene in the world frame (see :func:`models.raycast.cast_rays`).
+        rng : numpy.random.Generator, optional
+            Source of noise and dropouts; without it the scan is noise-free.
+
+        Returns
+        -------
+        scan : Scan
+        hit : ndarray of int, shape (n,)
+            What each beam hit (index into segments then circles; -1 nothing; a dropped
+            or out-of-range reading still reports what the beam would have hit).
+        """
+        n = self.n_beams
+        angles = self.beam_angles()
+        if isinstance(sensor_poses, Pose2D):
+            xs = np.full(n, sensor_poses.x)
+            ys = np.full(n, sensor_poses.y)
+            yaws = np.full(n, sensor_poses.yaw)
+        else:
+            arr = np.array([(p.x, p.y, p.yaw) for p in sensor_poses], dtype=float)
+            xs, ys, yaws = arr[:, 0], arr[:, 1], arr[:, 2]
+        heading = yaws + angles
+        origins = np.column_stack([xs, ys])
+        directions = np.column_stack([np.cos(heading), np.sin(heading)])
+        dist, hit = cast_rays(origins, directions, segments, circles, self.range_max)
+        ranges = dist.copy()
+        if rng is not None:
+            finite = np.isfinite(ranges)
+            ranges[finite] += rng.normal(0.0, self.noise_std, int(finite.sum())) if self.noise_std > 0 else 0.0
+            if self.dropout > 0:
+                ranges[rng.random(n) < self.dropout] = self.dropout_value
+        ranges[np.isfinite(ranges) & ((ranges >= self.range_max) | (ranges <= self.range_min))] = np.inf
+        scan = Scan(ranges.astype(np.float32), self.angle_min, self.angle_increment, self.range_min,
+                    self.range_max, stamp=stamp, frame_id=self.frame_id, time_increment=self.time_increment)
+        return scan, hit

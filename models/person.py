@@ -1,0 +1,173 @@
+"""The walking person: two legs with a gait, following waypoints at a given speed.
+
+A person's torso moves along a polyline of waypoints at the walker's speed, pausing where
+told. The legs are placed by the torso's arc length ``s`` along the path, so a paused
+person's legs stand still and a walking person's stance leg does too:
+
+* footprints lie every ``step_length`` metres along the path, alternately left and right
+  of it by half the leg spacing;
+* while the torso goes from footprint ``k`` to ``k + 1``, one leg stands on footprint ``k``
+  (stance) and the other swings from footprint ``k - 1`` to ``k + 1``: twice the distance in
+  the same time, so at about twice the walking speed;
+* the cadence (steps per second) is ``speed / step_length``, so it follows the speed.
+
+Pauses start at the middle of a step, where the swinging leg passes the standing one, so a
+standing person has both feet side by side.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class PersonModel:
+    """Body dimensions, metres.
+
+    Attributes
+    ----------
+    leg_radius : float
+        Radius of a leg at scanner height (5–8 cm).
+    leg_spacing : float
+        Distance between the legs' centres across the walking direction (10–30 cm).
+    step_length : float
+        Distance the torso travels per step.
+    """
+
+    leg_radius: float = 0.065
+    leg_spacing: float = 0.20
+    step_length: float = 0.60
+
+    @staticmethod
+    def sample(rng: np.random.Generator, speed: float) -> "PersonModel":
+        """A random adult: radius 5–8 cm, spacing 10–30 cm, step length growing with speed."""
+        step = float(np.clip(0.35 + 0.22 * speed + rng.normal(0.0, 0.03), 0.3, 0.85))
+        return PersonModel(float(rng.uniform(0.05, 0.08)), float(rng.uniform(0.12, 0.28)), step)
+
+
+@dataclass
+class Walker:
+    """A person following waypoints.
+
+    Parameters
+    ----------
+    person_id : int
+    waypoints : array-like, shape (w, 2)
+        Path in the world frame, metres; the person starts at the first point.
+    speed : float or sequence of float
+        Walking speed on each leg of the path, m/s (one value for all).
+    pauses : dict[int, float]
+        Seconds to stand at waypoint ``i`` (index into ``waypoints``) before going on.
+    start_time : float
+        When the person starts walking, seconds; before it they are not in the scene.
+    exit_at_end : bool
+        Leave the scene at the last waypoint instead of standing there.
+    body : PersonModel
+    """
+
+    person_id: int
+    waypoints: np.ndarray
+    speed: float | list[float] = 1.0
+    pauses: dict[int, float] = field(default_factory=dict)
+    start_time: float = 0.0
+    exit_at_end: bool = False
+    body: PersonModel = field(default_factory=PersonModel)
+
+    def __post_init__(self) -> None:
+        wp = np.asarray(self.waypoints, dtype=float).reshape(-1, 2)
+        if len(wp) == 1:
+            wp = np.vstack([wp, wp])
+        self.waypoints = wp
+        seg = np.diff(wp, axis=0)
+        self._seg_len = np.hypot(seg[:, 0], seg[:, 1])
+        self._cum = np.concatenate([[0.0], np.cumsum(self._seg_len)])  # arc length at each waypoint
+        speeds = np.broadcast_to(np.asarray(self.speed, dtype=float), (len(seg),)).astype(float)
+        if (speeds <= 0).any():
+            raise ValueError("walking speed must be positive")
+        L = self.body.step_length
+
+        def mid_step_at_or_after(s: float) -> float:  # feet side by side there
+            return (math.ceil(s / L - 0.5) + 0.5) * L
+
+        total = float(self._cum[-1])
+        # the walk ends at the last mid-step of the path, so a person standing there has
+        # both feet side by side
+        s_end = (math.floor(total / L - 0.5) + 0.5) * L if total >= 0.5 * L else total
+        # timeline of pieces (t_start, s_start, speed); speed 0 for a pause
+        t, s = self.start_time, 0.0
+        pieces = []
+        for i in range(len(seg) + 1):
+            pause = float(self.pauses.get(i, 0.0))
+            if pause > 0:
+                stop = min(mid_step_at_or_after(s), s_end)
+                v = speeds[min(i, len(seg) - 1)]
+                if stop > s:
+                    pieces.append((t, s, v))
+                    t += (stop - s) / v
+                    s = stop
+                pieces.append((t, s, 0.0))
+                t += pause
+            if i < len(seg):
+                goal = min(float(self._cum[i + 1]), s_end)
+                if goal > s:
+                    pieces.append((t, s, speeds[i]))
+                    t += (goal - s) / speeds[i]
+                    s = goal
+        self._pieces = np.array(pieces if pieces else [(t, s, 0.0)], dtype=float)
+        self.end_time = t
+        self._s_end = s
+
+    def present(self, t: float) -> bool:
+        """Whether the person is in the scene at time ``t`` (s)."""
+        return t >= self.start_time and not (self.exit_at_end and t > self.end_time)
+
+    def arc_length(self, t: float) -> float:
+        """Distance walked along the path by time ``t``, metres."""
+        if t <= self.start_time:
+            return 0.0
+        if t >= self.end_time:
+            return self._s_end
+        i = int(np.searchsorted(self._pieces[:, 0], t, side="right")) - 1
+        t0, s0, v = self._pieces[i]
+        return float(min(s0 + v * (t - t0), self._s_end))
+
+    def _at(self, s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Point and unit direction of the path at arc length ``s``."""
+        s = float(np.clip(s, 0.0, self._cum[-1]))
+        i = int(np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self._seg_len) - 1))
+        while self._seg_len[i] == 0 and i + 1 < len(self._seg_len):
+            i += 1
+        d = self.waypoints[i + 1] - self.waypoints[i]
+        length = self._seg_len[i]
+        u = d / length if length > 0 else np.array([1.0, 0.0])
+        return self.waypoints[i] + u * (s - self._cum[i]), u
+
+    def torso(self, t: float) -> np.ndarray:
+        """Torso position (the ground truth) at time ``t``, world frame, metres."""
+        return self._at(self.arc_length(t))[0]
+
+    def velocity(self, t: float, dt: float = 1e-3) -> np.ndarray:
+        """Torso velocity at time ``t``, m/s."""
+        return (self.torso(t + dt) - self.torso(t - dt)) / (2 * dt)
+
+    def _footprint(self, k: int) -> np.ndarray:
+        p, u = self._at(k * self.body.step_length)
+        side = 1.0 if k % 2 == 0 else -1.0  # even footprints left of the path, odd right
+        normal = np.array([-u[1], u[0]])
+        return p + side * 0.5 * self.body.leg_spacing * normal
+
+    def legs(self, t: float) -> np.ndarray:
+        """Centres of the two legs at time ``t``, shape (2, 2): row 0 the stance leg."""
+        L = self.body.step_length
+        s = self.arc_length(t)
+        k = int(math.floor(s / L + 1e-9))
+        phase = s / L - k  # 0 … 1 through the step
+        stance = self._footprint(k)
+        a, b = self._footprint(k - 1), self._footprint(k + 1)
+        # footprints k-1 and k+1 lie on the same side, so the swinging leg passes beside
+        # the standing one
+        swing = a + (b - a) * phase
+        return np.vstack([stance, swing])

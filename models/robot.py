@@ -1,0 +1,90 @@
+"""The simulated robot: unicycle motion and odometry with drift."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from models.pose import Pose2D, wrap_angle
+
+
+@dataclass(frozen=True)
+class Command:
+    """Velocity command in the robot's base frame: forward m/s, turn rad/s."""
+
+    v: float = 0.0
+    omega: float = 0.0
+
+
+def integrate(pose: Pose2D, cmd: Command, dt: float) -> Pose2D:
+    """Exact unicycle motion for ``dt`` seconds at constant ``cmd``."""
+    th = pose.yaw
+    if abs(cmd.omega) < 1e-9:
+        return Pose2D(pose.x + cmd.v * dt * math.cos(th), pose.y + cmd.v * dt * math.sin(th), th)
+    r = cmd.v / cmd.omega
+    th1 = th + cmd.omega * dt
+    return Pose2D(pose.x + r * (math.sin(th1) - math.sin(th)), pose.y - r * (math.cos(th1) - math.cos(th)),
+                  float(wrap_angle(th1)))
+
+
+class ScriptedDriver:
+    """Commands from a script of ``(duration_s, v, omega)`` pieces, then stop."""
+
+    def __init__(self, pieces: list[tuple[float, float, float]]) -> None:
+        self._ends = np.cumsum([p[0] for p in pieces]) if pieces else np.zeros(0)
+        self._cmds = [Command(p[1], p[2]) for p in pieces]
+
+    def __call__(self, t: float, pose: Pose2D) -> Command:
+        i = int(np.searchsorted(self._ends, t, side="right"))
+        return self._cmds[i] if i < len(self._cmds) else Command()
+
+
+class WaypointDriver:
+    """Drives through waypoints at ``speed`` (m/s), turning at up to ``max_turn`` rad/s."""
+
+    def __init__(self, waypoints, speed: float, max_turn: float = 1.0, tolerance: float = 0.2) -> None:
+        self._wp = [np.asarray(w, dtype=float) for w in waypoints]
+        self._i = 0
+        self._speed, self._max_turn, self._tol = speed, max_turn, tolerance
+
+    def __call__(self, t: float, pose: Pose2D) -> Command:
+        while self._i < len(self._wp) and math.hypot(*(self._wp[self._i] - (pose.x, pose.y))) < self._tol:
+            self._i += 1
+        if self._i >= len(self._wp):
+            return Command()
+        gx, gy = self._wp[self._i]
+        err = float(wrap_angle(math.atan2(gy - pose.y, gx - pose.x) - pose.yaw))
+        omega = float(np.clip(2.0 * err, -self._max_turn, self._max_turn))
+        v = self._speed * max(0.0, math.cos(err)) ** 2  # slow down to turn
+        return Command(v, omega)
+
+
+class Odometer:
+    """Wheel odometry: integrates the true motion with a drifting error.
+
+    The error of each scan period's motion is ``trans_noise`` of the distance travelled
+    (along and across) and ``rot_noise`` radians per radian turned (1σ), drawn afresh each
+    ``noise_period`` seconds, so consecutive scans see the stated relative error.
+    """
+
+    def __init__(self, start: Pose2D, rng: np.random.Generator, trans_noise: float = 0.0,
+                 rot_noise: float = 0.0, noise_period: float = 0.1) -> None:
+        self.pose = start  # in the odometry frame, which starts at the true start pose
+        self._rng, self._tn, self._rn, self._period = rng, trans_noise, rot_noise, noise_period
+        self._next_draw = -math.inf
+        self._scale = (1.0, 0.0, 1.0)
+
+    def update(self, t: float, before: Pose2D, after: Pose2D) -> Pose2D:
+        """Add the true motion from ``before`` to ``after`` (world poses) with drift."""
+        if t >= self._next_draw:
+            n = self._rng.normal(size=3)
+            self._scale = (1.0 + self._tn * n[0], self._tn * n[1], 1.0 + self._rn * n[2])
+            self._next_draw = t + self._period
+        rel = before.between(after)  # motion in the base frame
+        dist = math.hypot(rel.x, rel.y)
+        noisy = Pose2D(rel.x * self._scale[0] + dist * self._scale[1] * (1 if rel.x >= 0 else -1),
+                       rel.y * self._scale[0], rel.yaw * self._scale[2])
+        self.pose = self.pose @ noisy
+        return self.pose

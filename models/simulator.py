@@ -1,0 +1,213 @@
+"""The simulator: walking people, a static world, a robot and its laser, with ground truth.
+
+Driven through :meth:`Simulation.step`, which advances one scan period and returns the
+scan, the odometry since the previous step and the truth. A closed loop passes a
+controller's command into ``step``; ``models`` never imports ``tracker``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from models.laser import LaserModel
+from models.person import Walker
+from models.pose import Pose2D
+from models.robot import Command, Odometer, integrate
+from models.scan import Scan
+from models.world import World
+
+VISIBLE_MIN_POINTS = 3  # Leigh et al.: a person is visible with 3 points ...
+VISIBLE_SPACING_M = 0.13  # ... in one cluster at 0.13 m spacing
+
+
+@dataclass(frozen=True, eq=False)
+class Truth:
+    """What really happened at one scan.
+
+    Attributes
+    ----------
+    robot_pose, sensor_pose : Pose2D
+        True base and sensor poses in the world frame at the scan stamp.
+    person_id : ndarray of int, shape (p,)
+        People in the scene.
+    torso_world, torso_sensor : ndarray, shape (p, 2)
+        Their torso positions in the world and the sensor frame, metres.
+    visible : ndarray of bool, shape (p,)
+        Visible by Leigh's rule: at least 3 of their readings form one cluster at 0.13 m spacing.
+    beam_person : ndarray of int, shape (n,)
+        Person id that each beam hit, -1 where it hit something else or nothing.
+    """
+
+    stamp: float
+    robot_pose: Pose2D
+    sensor_pose: Pose2D
+    person_id: np.ndarray
+    torso_world: np.ndarray
+    torso_sensor: np.ndarray
+    visible: np.ndarray
+    beam_person: np.ndarray
+
+
+@dataclass(frozen=True)
+class OdometrySample:
+    """Odometry at one instant: base pose in the odometry frame, velocity in the base frame."""
+
+    stamp: float
+    pose: Pose2D
+    v: float
+    omega: float
+
+
+@dataclass(frozen=True, eq=False)
+class SimStep:
+    """One scan period: the scan, the odometry base pose at its stamp (odometry frame),
+    the odometry samples published during the period, and the truth."""
+
+    scan: Scan
+    odom_pose: Pose2D
+    odometry: list[OdometrySample]
+    truth: Truth
+
+
+def visible_people(scan: Scan, beam_person: np.ndarray) -> set[int]:
+    """Ids of the people with at least 3 valid readings in one cluster at 0.13 m spacing."""
+    out: set[int] = set()
+    pts = scan.points
+    ok = scan.valid & (beam_person >= 0)
+    for pid in np.unique(beam_person[ok]):
+        idx = np.flatnonzero(ok & (beam_person == pid))
+        p = pts[idx]
+        gaps = np.hypot(*np.diff(p, axis=0).T) > VISIBLE_SPACING_M
+        # cluster sizes: runs between gaps
+        bounds = np.concatenate([[0], np.flatnonzero(gaps) + 1, [len(idx)]])
+        if np.diff(bounds).max() >= VISIBLE_MIN_POINTS:
+            out.add(int(pid))
+    return out
+
+
+@dataclass
+class Simulation:
+    """A running simulated scene.
+
+    Parameters
+    ----------
+    laser : LaserModel
+    world : World
+    walkers : list of Walker
+    mount : Pose2D
+        base_T_laser.
+    start : Pose2D
+        Robot base pose in the world at t = 0.
+    driver : callable (t, pose) -> Command, optional
+        The robot's own motion (None: it stands still unless ``step`` gets a command).
+    rng : numpy.random.Generator
+    odom_trans_noise, odom_rot_noise : float
+        Odometry drift, fraction of distance and radians per radian (1σ per scan period).
+    odom_rate_hz : float
+        Odometry messages per second.
+    t0 : float
+        Stamp of the first scan, seconds.
+    """
+
+    laser: LaserModel
+    world: World
+    walkers: list[Walker]
+    rng: np.random.Generator
+    mount: Pose2D = field(default_factory=Pose2D)
+    start: Pose2D = field(default_factory=Pose2D)
+    driver: Callable[[float, Pose2D], Command] | None = None
+    odom_trans_noise: float = 0.0
+    odom_rot_noise: float = 0.0
+    odom_rate_hz: float = 50.0
+    t0: float = 1000.0
+    physics_hz: float = 200.0
+
+    def __post_init__(self) -> None:
+        self.index = 0
+        self.time = 0.0  # scenario time of the next scan
+        self.robot = self.start
+        self._odometer = Odometer(Pose2D(), self.rng, self.odom_trans_noise, self.odom_rot_noise,
+                                  self.laser.period)
+        self._odom_origin = self.start
+        self._last_cmd = Command()
+        self._next_odom = 0.0
+
+    def _people_circles(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        present = [w for w in self.walkers if w.present(t)]
+        circles = np.zeros((2 * len(present), 3))
+        owner = np.zeros(2 * len(present), dtype=np.int64)
+        for i, w in enumerate(present):
+            circles[2 * i: 2 * i + 2, :2] = w.legs(t)
+            circles[2 * i: 2 * i + 2, 2] = w.body.leg_radius
+            owner[2 * i: 2 * i + 2] = w.person_id
+        return circles, owner
+
+    def step(self, command: Command | None = None) -> SimStep:
+        """Render the scan at the current time, then advance the robot one scan period.
+
+        ``command`` overrides the scenario's driver for this period (a closed loop).
+        """
+        t = self.time
+        laser = self.laser
+        stamp = self.t0 + t
+        # the robot moves while the beams sweep: poses at each beam's firing time
+        sweep = laser.time_increment * (laser.n_beams - 1)
+        cmd = command if command is not None else (self.driver(t, self.robot) if self.driver else Command())
+        moving = abs(cmd.v) > 0 or abs(cmd.omega) > 0
+        if moving and sweep > 0:
+            n_sub = 16
+            sub_t = np.linspace(0.0, sweep, n_sub)
+            sub_poses = [integrate(self.robot, cmd, dt) @ self.mount for dt in sub_t]
+            which = np.minimum((np.arange(laser.n_beams) * laser.time_increment / sweep * (n_sub - 1) + 0.5).astype(int), n_sub - 1)
+            beam_poses = [sub_poses[k] for k in which]
+        else:
+            beam_poses = self.robot @ self.mount
+        circles, owner = self._people_circles(t)
+        all_circles = np.vstack([self.world.circles, circles]) if len(circles) else self.world.circles
+        scan, hit = laser.render(stamp, beam_poses, self.world.segments, all_circles, self.rng)
+        n_static = len(self.world.segments) + len(self.world.circles)
+        beam_person = np.full(laser.n_beams, -1, dtype=np.int64)
+        on_person = hit >= n_static
+        beam_person[on_person] = owner[hit[on_person] - n_static]
+        sensor = self.robot @ self.mount
+        present = [w for w in self.walkers if w.present(t)]
+        ids = np.array([w.person_id for w in present], dtype=np.int64)
+        torso = np.array([w.torso(t) for w in present]).reshape(-1, 2)
+        torso_sensor = sensor.inverse().transform_points(torso) if len(torso) else torso
+        seen = visible_people(scan, beam_person)
+        truth = Truth(stamp, self.robot, sensor, ids, torso, torso_sensor,
+                      np.array([i in seen for i in ids], dtype=bool), beam_person)
+        odom_pose = self._odometer.pose
+        odometry = [self.odometry_now()] if self.index == 0 else []
+        odometry += self._advance(cmd, command is not None)
+        self.index += 1
+        return SimStep(scan, odom_pose, odometry, truth)
+
+    def _advance(self, cmd: Command, external: bool) -> list[OdometrySample]:
+        """Move the robot through one scan period; odometry samples on the way."""
+        dt = 1.0 / self.physics_hz
+        period = self.laser.period
+        t = self.time
+        end = t + period
+        samples = []
+        while t < end - 1e-12:
+            h = min(dt, end - t)
+            if not external and self.driver is not None:
+                cmd = self.driver(t, self.robot)
+            new = integrate(self.robot, cmd, h)
+            odom_pose = self._odometer.update(t, self.robot, new)
+            self.robot = new
+            t += h
+            if t >= self._next_odom - 1e-9:
+                samples.append(OdometrySample(self.t0 + t, odom_pose, cmd.v, cmd.omega))
+                self._next_odom += 1.0 / self.odom_rate_hz
+        self.time = end
+        return samples
+
+    def odometry_now(self) -> OdometrySample:
+        """The odometry pose at the current time (before any motion: the start)."""
+        return OdometrySample(self.t0 + self.time, self._odometer.pose, 0.0, 0.0)
