@@ -75,6 +75,7 @@ class Walker:
     start_time: float = 0.0
     exit_at_end: bool = False
     body: PersonModel = field(default_factory=PersonModel)
+    round_radius: float | None = None  # set: a round object of this radius (m) instead of two legs
 
     def __post_init__(self) -> None:
         wp = np.asarray(self.waypoints, dtype=float).reshape(-1, 2)
@@ -158,6 +159,12 @@ class Walker:
         side = 1.0 if k % 2 == 0 else -1.0  # even footprints left of the path, odd right
         normal = np.array([-u[1], u[0]])
         return p + side * 0.5 * self.body.leg_spacing * normal
+
+    def circles(self, t: float) -> np.ndarray:
+        """What the laser sees at time ``t``: circles (x, y, r), shape (2, 3) for legs, (1, 3) round."""
+        if self.round_radius is not None:
+            return np.array([[*self.torso(t), self.round_radius]])
+        return np.column_stack([self.legs(t), np.full(2, self.body.leg_radius)])
 
     def legs(self, t: float) -> np.ndarray:
         """Centres of the two legs at time ``t``, shape (2, 2): row 0 the stance leg."""

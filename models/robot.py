@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -88,3 +89,26 @@ class Odometer:
                        rel.y * self._scale[0], rel.yaw * self._scale[2])
         self.pose = self.pose @ noisy
         return self.pose
+
+
+class FollowDriver:
+    """Follows a target at ``distance`` metres, given where the target is (world frame).
+
+    ``target(t)`` returns the target's position or None when it is not known; the robot
+    then stops. The simulator's scenarios give it the true position; the following demo
+    gives it the tracker's estimate.
+    """
+
+    def __init__(self, target: Callable[[float], "np.ndarray | None"], distance: float = 1.0,
+                 max_speed: float = 1.2, max_turn: float = 1.5) -> None:
+        self._target, self._dist, self._vmax, self._wmax = target, distance, max_speed, max_turn
+
+    def __call__(self, t: float, pose: Pose2D) -> Command:
+        goal = self._target(t)
+        if goal is None:
+            return Command()
+        dx, dy = goal[0] - pose.x, goal[1] - pose.y
+        err = float(wrap_angle(math.atan2(dy, dx) - pose.yaw))
+        gap = math.hypot(dx, dy) - self._dist
+        v = float(np.clip(0.8 * gap, 0.0, self._vmax)) * max(0.0, math.cos(err))
+        return Command(v, float(np.clip(2.0 * err, -self._wmax, self._wmax)))

@@ -137,14 +137,12 @@ class Simulation:
         self._next_odom = 0.0
 
     def _people_circles(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        present = [w for w in self.walkers if w.present(t)]
-        circles = np.zeros((2 * len(present), 3))
-        owner = np.zeros(2 * len(present), dtype=np.int64)
-        for i, w in enumerate(present):
-            circles[2 * i: 2 * i + 2, :2] = w.legs(t)
-            circles[2 * i: 2 * i + 2, 2] = w.body.leg_radius
-            owner[2 * i: 2 * i + 2] = w.person_id
-        return circles, owner
+        parts = [w.circles(t) for w in self.walkers if w.present(t)]
+        if not parts:
+            return np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
+        ids = [w.person_id for w in self.walkers if w.present(t)]
+        owner = np.concatenate([np.full(len(c), pid, dtype=np.int64) for c, pid in zip(parts, ids)])
+        return np.vstack(parts), owner
 
     def step(self, command: Command | None = None) -> SimStep:
         """Render the scan at the current time, then advance the robot one scan period.

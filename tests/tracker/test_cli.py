@@ -114,10 +114,6 @@ def test_bad_scans_inside_a_good_recording_warn_once_each_and_keep_their_index(t
     assert "12 read, 9 used, 3 skipped, 1 history restarts" in proc.stdout
 
 
-def test_run_without_input_says_the_scene_is_not_there_yet():
-    proc = run_cli("run")
-    assert_one_line_error(proc, "simulated scene")
-
 
 def test_console_script_is_installed_beside_the_interpreter():
     import sys
