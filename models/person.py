@@ -17,6 +17,7 @@ standing person has both feet side by side.
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass, field
 
@@ -85,6 +86,10 @@ class Walker:
         seg = np.diff(wp, axis=0)
         self._seg_len = np.hypot(seg[:, 0], seg[:, 1])
         self._cum = np.concatenate([[0.0], np.cumsum(self._seg_len)])  # arc length at each waypoint
+        self._cum_list = self._cum.tolist()
+        with np.errstate(invalid="ignore", divide="ignore"):
+            unit = seg / self._seg_len[:, None]
+        self._unit = np.where(self._seg_len[:, None] > 0, unit, [1.0, 0.0])
         speeds = np.broadcast_to(np.asarray(self.speed, dtype=float), (len(seg),)).astype(float)
         if (speeds <= 0).any():
             raise ValueError("walking speed must be positive")
@@ -137,14 +142,14 @@ class Walker:
 
     def _at(self, s: float) -> tuple[np.ndarray, np.ndarray]:
         """Point and unit direction of the path at arc length ``s``."""
-        s = float(np.clip(s, 0.0, self._cum[-1]))
-        i = int(np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self._seg_len) - 1))
-        while self._seg_len[i] == 0 and i + 1 < len(self._seg_len):
+        cum = self._cum_list
+        s = min(max(float(s), 0.0), cum[-1])
+        last = len(self._seg_len) - 1
+        i = min(max(bisect.bisect_right(cum, s) - 1, 0), last)
+        while self._seg_len[i] == 0 and i < last:
             i += 1
-        d = self.waypoints[i + 1] - self.waypoints[i]
-        length = self._seg_len[i]
-        u = d / length if length > 0 else np.array([1.0, 0.0])
-        return self.waypoints[i] + u * (s - self._cum[i]), u
+        u = self._unit[i]
+        return self.waypoints[i] + u * (s - cum[i]), u
 
     def torso(self, t: float) -> np.ndarray:
         """Torso position (the ground truth) at time ``t``, world frame, metres."""

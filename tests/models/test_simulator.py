@@ -165,3 +165,25 @@ def test_bad_scenarios_name_the_key(tmp_path, bad, key):
     f.write_text(yaml.safe_dump(bad))
     with pytest.raises(ScenarioError, match=key.replace("[", r"\[").replace("]", r"\]")):
         build_simulation(load_scenario(f))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_culled_ray_caster_equals_the_dense_one(seed):
+    from models.raycast import cast_rays_dense
+    rng = np.random.default_rng(seed)
+    n = 500
+    clockwise = seed % 2 == 1
+    fov = math.radians(360 - 0.5) if seed % 3 == 0 else math.radians(270)
+    yaw0 = rng.uniform(-np.pi, np.pi)
+    ang = yaw0 + (np.linspace(fov / 2, -fov / 2, n) if clockwise else np.linspace(-fov / 2, fov / 2, n))
+    # a sensor moving 10 cm during the sweep
+    origins = np.column_stack([np.linspace(0, 0.1, n), np.linspace(0, 0.03, n)]) + rng.uniform(-1, 1, 2)
+    dirs = np.column_stack([np.cos(ang), np.sin(ang)])
+    a = rng.uniform(-8, 8, (60, 2))
+    segments = np.stack([a, a + rng.uniform(-4, 4, (60, 2))], axis=1)
+    circles = np.column_stack([rng.uniform(-6, 6, (80, 2)), rng.uniform(0.03, 0.4, 80)])
+    circles[0, :2] = origins[0] + [0.05, 0.0]  # the sensor inside a circle
+    d1, h1 = cast_rays(origins, dirs, segments, circles, 12.0)
+    d2, h2 = cast_rays_dense(origins, dirs, segments, circles, 12.0)
+    np.testing.assert_allclose(d1, d2, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(h1[np.isfinite(d1)], h2[np.isfinite(d2)])
