@@ -57,9 +57,17 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--topic", help="LaserScan topic (default: the only one)")
     run.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
 
-    ev = sub.add_parser("evaluate", help="score a tracks CSV against ground truth")
-    ev.add_argument("tracks", metavar="TRACKS.csv")
-    ev.add_argument("--ground-truth", required=True, metavar="BAG|GT.csv")
+    ev = sub.add_parser("evaluate", help="score a tracks CSV against ground truth (CLEAR MOT, IDF1, OSPA)")
+    ev.add_argument("tracks", metavar="TRACKS.csv", help="needs the columns scan_index,track_id,x,y")
+    ev.add_argument("--ground-truth", required=True, metavar="BAG|GT.csv",
+                    help="an annotated recording or a ground-truth CSV (scan_index,person_id,x,y)")
+    ev.add_argument("--protocol", choices=("general", "following"), default="general")
+    ev.add_argument("--threshold", type=float, default=0.75, metavar="M", help="match distance, metres (0.75)")
+    ev.add_argument("--topic", help="scan topic of the annotated recording (every scan is a frame)")
+    ev.add_argument("--gt-topic", help="ground-truth topic (leg_tracker/Person) of the recording")
+    ev.add_argument("--ospa-cutoff", type=float, default=1.0, metavar="M", help="OSPA cut-off c, metres (1.0)")
+    ev.add_argument("--ospa-order", type=float, default=1.0, metavar="P", help="OSPA order p (1)")
+    ev.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
 
     sim = sub.add_parser("simulate", help="render a simulated scenario to a ROS 2 bag (MCAP) with ground truth")
     sim.add_argument("scenario", metavar="SCENARIO", help="a name from configs/scenarios or a YAML file")
@@ -135,7 +143,30 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_evaluate(args) -> int:
-    raise InputError("evaluate is not available yet (it arrives with the evaluation issue)")
+    import json
+
+    from tracker.evaluation import evaluate, format_table
+    from tracker.io.atomic import atomic_output, check_writable
+    from tracker.io.ground_truth import read_ground_truth
+    from tracker.io.tracks_csv import read_tracks_csv
+
+    for name, value in (("--threshold", args.threshold), ("--ospa-cutoff", args.ospa_cutoff),
+                        ("--ospa-order", args.ospa_order)):
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"{name} must be a positive number, got {value}")
+    if args.json:
+        check_writable(args.json)
+    tracks = read_tracks_csv(args.tracks)
+    gt = read_ground_truth(args.ground_truth, args.topic, args.gt_topic)
+    result = evaluate(gt, tracks, args.protocol, args.threshold, args.ospa_cutoff, args.ospa_order)
+    result["tracks_file"] = str(args.tracks)
+    result["ground_truth_file"] = str(args.ground_truth)
+    print(format_table(result))
+    if args.json:
+        with atomic_output(args.json) as fh:
+            json.dump({k: (None if isinstance(v, float) and v != v else v) for k, v in result.items()}, fh, indent=2)
+            fh.write("\n")
+    return 0
 
 
 def _cmd_simulate(args) -> int:

@@ -1,0 +1,154 @@
+"""Tracker accuracy against ground truth: CLEAR MOT (Leigh et al., ICRA 2015), IDF1, OSPA.
+
+Protocols (Leigh et al.):
+
+* ``general``: every person. A track within ``threshold`` metres of a person can match it
+  (CLEAR MOT's assignment, keeping last frame's matches while they stay in range);
+  ``MOTA = 1 - (misses + false positives + id switches) / ground-truth people``, ``MOTP``
+  the mean distance of the matches in metres.
+* ``following``: the ground truth holds only the followed person; the tracks are the
+  target's (rows with ``target == 1`` when the file says which). False positives are
+  counted but do not lower MOTA: ``MOTA = 1 - (misses + id switches) / ground truth``.
+
+Every scan is a frame, including scans where nobody is annotated (a reported person
+there is a false positive). Positions are compared in the sensor frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from tracker.io.ground_truth import GroundTruth
+
+
+@dataclass(frozen=True, eq=False)
+class TrackRows:
+    """Reported tracks: one row per track per scan, sensor frame, metres."""
+
+    scan_index: np.ndarray
+    track_id: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    target: np.ndarray | None = None  # 1 for the followed person, when the file says
+
+    def __len__(self) -> int:
+        return int(self.scan_index.shape[0])
+
+
+def _by_frame(index: np.ndarray, n_frames: int) -> list[np.ndarray]:
+    """Row numbers of each frame 0..n_frames-1."""
+    order = np.argsort(index, kind="stable")
+    bounds = np.searchsorted(index[order], np.arange(n_frames + 1))
+    return [order[bounds[k]:bounds[k + 1]] for k in range(n_frames)]
+
+
+def ospa(gt_xy: np.ndarray, tr_xy: np.ndarray, cutoff: float, order: float) -> float:
+    """OSPA distance (Schuhmacher et al. 2008) between two point sets, metres."""
+    m, n = len(gt_xy), len(tr_xy)
+    if m == 0 and n == 0:
+        return 0.0
+    if m == 0 or n == 0:
+        return cutoff
+    d = np.minimum(np.hypot(gt_xy[:, None, 0] - tr_xy[None, :, 0], gt_xy[:, None, 1] - tr_xy[None, :, 1]), cutoff)
+    cost = d ** order
+    rows, cols = linear_sum_assignment(cost)
+    # (1/n (Σ d_c^p over the assignment + c^p |m - n|))^(1/p)
+    total = cost[rows, cols].sum() + cutoff ** order * abs(m - n)
+    return float((total / max(m, n)) ** (1.0 / order))
+
+
+def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", threshold: float = 0.75,
+             ospa_cutoff: float = 1.0, ospa_order: float = 1.0, n_frames: int | None = None) -> dict:
+    """Score ``tracks`` against ``gt``.
+
+    Parameters
+    ----------
+    gt : GroundTruth
+    tracks : TrackRows
+    protocol : {'general', 'following'}
+    threshold : float
+        Largest distance of a match, metres.
+    ospa_cutoff, ospa_order : float
+        OSPA's cut-off c (metres) and order p.
+    n_frames : int, optional
+        Number of frames; default ``gt.n_frames`` or the largest index seen plus one.
+
+    Returns
+    -------
+    dict
+        frames, ground_truth, matches, misses, false_positives, id_switches, mota, motp (m),
+        idf1, ospa (m, mean over frames), and the protocol and parameters used.
+    """
+    import motmetrics as mm  # imported here: pandas is slow to import and only evaluation needs it
+
+    if protocol not in ("general", "following"):
+        raise ValueError(f"protocol must be general or following, got {protocol!r}")
+    if protocol == "following" and tracks.target is not None:
+        keep = tracks.target == 1
+        tracks = TrackRows(tracks.scan_index[keep], tracks.track_id[keep], tracks.x[keep], tracks.y[keep], tracks.target[keep])
+    last = max(int(gt.scan_index.max(initial=-1)), int(tracks.scan_index.max(initial=-1)))
+    frames = n_frames if n_frames is not None else (gt.n_frames if gt.n_frames is not None else last + 1)
+    frames = max(frames, last + 1)
+    gt_rows = _by_frame(gt.scan_index, frames)
+    tr_rows = _by_frame(tracks.scan_index, frames)
+    acc = mm.MOTAccumulator(auto_id=True)
+    ospas = np.empty(frames)
+    for k in range(frames):
+        g, t = gt_rows[k], tr_rows[k]
+        gxy = np.column_stack([gt.x[g], gt.y[g]])
+        txy = np.column_stack([tracks.x[t], tracks.y[t]])
+        # Euclidean distances (not squared: MOTP is then in metres); beyond the threshold: no match
+        d = np.hypot(gxy[:, None, 0] - txy[None, :, 0], gxy[:, None, 1] - txy[None, :, 1]) if len(g) and len(t) \
+            else np.zeros((len(g), len(t)))
+        d[d > threshold] = np.nan
+        acc.update(gt.person_id[g].tolist(), tracks.track_id[t].tolist(), d)
+        ospas[k] = ospa(gxy, txy, ospa_cutoff, ospa_order)
+    summary = mm.metrics.create().compute(
+        acc, metrics=["num_objects", "num_detections", "num_misses", "num_false_positives", "num_switches",
+                      "motp", "idf1"], name="all")
+    row = summary.loc["all"]
+    n_gt = int(row["num_objects"])
+    misses, fps, switches = int(row["num_misses"]), int(row["num_false_positives"]), int(row["num_switches"])
+    errors = misses + switches + (0 if protocol == "following" else fps)
+    return {
+        "protocol": protocol,
+        "threshold_m": threshold,
+        "frames": int(frames),
+        "ground_truth": n_gt,
+        "tracks_reported": int(len(tracks)),
+        "matches": int(row["num_detections"]),  # CLEAR MOT correspondences, switches included
+        "misses": misses,
+        "false_positives": fps,
+        "id_switches": switches,
+        "mota": (1.0 - errors / n_gt) if n_gt else float("nan"),
+        "motp_m": float(row["motp"]) if int(row["num_detections"]) else float("nan"),
+        "idf1": float(row["idf1"]) if n_gt + len(tracks) else float("nan"),
+        "ospa_m": float(ospas.mean()) if frames else float("nan"),
+        "ospa_cutoff_m": ospa_cutoff,
+        "ospa_order": ospa_order,
+    }
+
+
+def format_table(result: dict) -> str:
+    """The result as an aligned, readable table."""
+    pct = lambda v: "n/a" if v != v else f"{100 * v:.1f} %"  # noqa: E731
+    metres = lambda v: "n/a" if v != v else f"{v:.3f} m"  # noqa: E731
+    lines = [
+        (f"protocol", f"{result['protocol']} (match within {result['threshold_m']:g} m)"),
+        ("frames", f"{result['frames']}"),
+        ("ground-truth people", f"{result['ground_truth']}"),
+        ("reported tracks", f"{result['tracks_reported']}"),
+        ("matches", f"{result['matches']}"),
+        ("misses", f"{result['misses']}"),
+        ("false positives", f"{result['false_positives']}" + (" (not counted in MOTA)" if result["protocol"] == "following" else "")),
+        ("id switches", f"{result['id_switches']}"),
+        ("MOTA", pct(result["mota"])),
+        ("MOTP", metres(result["motp_m"])),
+        ("IDF1", pct(result["idf1"])),
+        (f"OSPA (c={result['ospa_cutoff_m']:g} m, p={result['ospa_order']:g})", metres(result["ospa_m"])),
+    ]
+    width = max(len(k) for k, _ in lines)
+    return "\n".join(f"{k:<{width}}  {v}" for k, v in lines)
