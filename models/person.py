@@ -101,7 +101,7 @@ class Walker:
         total = float(self._cum[-1])
         # the walk ends at the last mid-step of the path, so a person standing there has
         # both feet side by side
-        s_end = (math.floor(total / L - 0.5) + 0.5) * L if total >= 0.5 * L else total
+        s_end = (math.floor(total / L - 0.5) + 0.5) * L if total >= 0.5 * L and self.round_radius is None else total
         # timeline of pieces (t_start, s_start, speed); speed 0 for a pause
         t, s = self.start_time, 0.0
         pieces = []

@@ -1,0 +1,201 @@
+"""The paper's moving-object detector, scan by scan.
+
+:class:`MovingObjectDetector` keeps the recent scans and their poses; each call compares the
+current scan with one or more earlier scans chosen by time (Δt in seconds, turned into a
+number of scans from the stamps) and returns per-beam labels and the moving objects.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from detection.closest import closest_point_static
+from detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
+from detection.objects import MovingObject, describe
+from detection.recover import recover_moving
+from detection.scan_lines import bin_to_beams, scan_line_labels
+from detection.segments import split_runs
+from detection.thresholds import range_threshold
+from models.pose import Pose2D
+from models.scan import Scan
+
+
+@dataclass(frozen=True)
+class DetectorParams:
+    """Tunables of the detector (units in the names; k factors are dimensionless).
+
+    Attributes
+    ----------
+    k_closest, closest_floor_m
+        Δd_c = max(k · tan(res/2) · r, floor): static when the other scan has a reading this close.
+    k_segment, segment_floor_m
+        The same form for the spacing of consecutive readings within a segment, and for Join.
+    scan_line_window
+        Beams either side searched for a previous reading on the same line of sight.
+    compare_dt_s
+        Δt to each earlier scan compared with, seconds (several: slow legs move enough over
+        the longer ones).
+    min_seed_points
+        An M segment needs this many readings to seed an object.
+    min_object_points
+        Objects with fewer readings are noise.
+    max_object_size_m
+        Join refuses to grow an object beyond this end-to-end length.
+    single_object_max_o
+        Algorithm 3 runs when O_C has at most this many segments (the single-object condition).
+    """
+
+    k_closest: float = 6.0
+    closest_floor_m: float = 0.04
+    k_segment: float = 12.0
+    segment_floor_m: float = 0.06
+    scan_line_window: int = 1
+    compare_dt_s: tuple[float, ...] = (0.1,)
+    min_seed_points: int = 2
+    min_object_points: int = 3
+    max_object_size_m: float = 1.0
+    single_object_max_o: int = 1
+
+
+@dataclass(frozen=True, eq=False)
+class Detection:
+    """What the detector found in one scan.
+
+    Attributes
+    ----------
+    labels : ndarray of int8, shape (n_beams,)
+        Set of each reading of the current scan (``detection.labels``).
+    objects : list of MovingObject
+    compared_dt_s : tuple of float
+        Actual Δt (s) to each earlier scan compared with; empty when there was none yet.
+    """
+
+    labels: np.ndarray
+    objects: list[MovingObject]
+    compared_dt_s: tuple[float, ...]
+
+
+@dataclass(frozen=True, eq=False)
+class _Past:
+    scan: Scan
+    pose: Pose2D | None
+
+
+def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams) -> np.ndarray:
+    """Labels of the current scan's readings from one comparison with an earlier scan.
+
+    ``rel`` is the earlier sensor pose seen from the current one (current_T_previous).
+    """
+    labels = np.zeros(scan.n_beams, dtype=np.int8)  # INVALID
+    valid_c = np.flatnonzero(scan.valid)
+    pts_c = scan.points[valid_c]
+    r_c = scan.ranges[valid_c]
+    pts_p = rel.transform_points(prev.valid_points)  # previous readings in the current frame
+    r_p = np.hypot(pts_p[:, 0], pts_p[:, 1])
+    # 1. closest points → A_C, A_P
+    static_c, static_p = closest_point_static(
+        pts_c, pts_p,
+        range_threshold(r_c, scan.resolution, params.k_closest, params.closest_floor_m),
+        range_threshold(r_p, prev.resolution, params.k_closest, params.closest_floor_m))
+    labels[valid_c[static_c]] = STATIC
+    # 2. Algorithm 1 on B_C, B_P: the previous readings binned to the current beams
+    b_c = valid_c[~static_c]
+    beam_all = bin_to_beams(pts_p, scan.angle_min, scan.angle_increment, scan.n_beams)
+    label_c, _ = scan_line_labels(b_c, scan.ranges[b_c], beam_all[~static_p], r_p[~static_p], scan.n_beams,
+                                  params.scan_line_window, beam_all, r_p)
+    labels[b_c] = label_c
+    return labels
+
+
+def combine(pairs: list[np.ndarray]) -> np.ndarray:
+    """One label per reading from several comparisons: moving in any → M; else occluded in
+    any → O; else static in any → A; else N."""
+    out = pairs[0].copy()
+    stack = np.stack(pairs)
+    valid = out != INVALID
+    out[valid] = OUT_OF_VIEW
+    for label in (STATIC, OCCLUDED, MOVING):  # later ones win
+        out[valid & (stack == label).any(axis=0)] = label
+    return out
+
+
+class MovingObjectDetector:
+    """Keeps the scan history and finds the moving objects of each new scan.
+
+    Parameters
+    ----------
+    params : DetectorParams
+    """
+
+    def __init__(self, params: DetectorParams | None = None) -> None:
+        self.params = params or DetectorParams()
+        self._history: deque[_Past] = deque()
+        self._next_id = 1
+        self._keep_s = 1.5 * max(self.params.compare_dt_s) + 1.0
+
+    def reset(self) -> None:
+        """Forget the history (after a stamp jump or a change of scanner)."""
+        self._history.clear()
+
+    def _earlier(self, stamp: float) -> list[_Past]:
+        """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""
+        if not self._history:
+            return []
+        stamps = np.array([p.scan.stamp for p in self._history])
+        chosen = []
+        for dt in self.params.compare_dt_s:
+            k = int(np.argmin(np.abs(stamps - (stamp - dt))))
+            past = self._history[k]
+            if all(past is not c for c in chosen):
+                chosen.append(past)
+        return chosen
+
+    def detect(self, scan: Scan, pose: Pose2D | None = None) -> Detection:
+        """Labels and moving objects of ``scan``.
+
+        Parameters
+        ----------
+        scan : Scan
+        pose : Pose2D, optional
+            Sensor pose in the fixed frame; without it the sensor is taken as still.
+        """
+        p = self.params
+        earlier = self._earlier(scan.stamp)
+        self._history.append(_Past(scan, pose))
+        while self._history and self._history[0].scan.stamp < scan.stamp - self._keep_s:
+            self._history.popleft()
+        if not earlier:
+            return Detection(np.where(scan.valid, OUT_OF_VIEW, INVALID).astype(np.int8), [], ())
+        pairs = []
+        for past in earlier:
+            rel = pose.between(past.pose) if pose is not None and past.pose is not None else Pose2D()
+            pairs.append(label_pair(scan, past.scan, rel, p))
+        labels = combine(pairs)
+        # 3. segments of each set, over the valid readings in beam order
+        valid = np.flatnonzero(scan.valid)
+        pts = scan.points[valid]
+        gap = range_threshold(scan.ranges[valid], scan.resolution, p.k_segment, p.segment_floor_m)
+        runs = split_runs(labels[valid], pts, gap)
+        # 4. Algorithms 2 and 3: recover whole objects
+        found = recover_moving(runs, pts, gap, p.min_seed_points, p.min_object_points, p.max_object_size_m,
+                               p.single_object_max_o)
+        # 5. position and box of each object big enough
+        objects = []
+        for seg in found:
+            if seg.size < p.min_object_points:
+                continue
+            objects.append(describe(self._next_id, valid[seg.start:seg.stop], pts[seg.start:seg.stop], seg.sets))
+            self._next_id += 1
+        return Detection(labels, objects, tuple(scan.stamp - e.scan.stamp for e in earlier))
+
+
+def v_min(params: DetectorParams, resolution: float, ranges_m=(1.0, 3.0, 5.0)) -> dict[float, list[float]]:
+    """Minimum detectable relative speed V_min = Δd_c / Δt (m/s) at the given ranges, per Δt."""
+    out = {}
+    for dt in params.compare_dt_s:
+        thr = range_threshold(np.asarray(ranges_m), resolution, params.k_closest, params.closest_floor_m)
+        out[dt] = (thr / dt).tolist()
+    return out

@@ -1,0 +1,65 @@
+"""Stage 4: recover whole objects. Join (Sec. 2.4), Algorithm 2 (recover) and Algorithm 3 (replace)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from detection.labels import MOVING, OCCLUDED, STATIC
+from detection.segments import Segment
+
+
+def join(runs: list[Segment], into: int, source: int, points: np.ndarray, join_threshold: np.ndarray,
+         max_extent: float) -> bool:
+    """Join(into, source): a segment of set ``into`` absorbs a neighbouring segment of set ``source``
+    whose nearer end lies within the join threshold of its own end.
+
+    The absorbed segment leaves ``source``, so it joins one object at most. Repeats until
+    nothing changes. A join that would make the object longer than ``max_extent`` metres
+    (end to end) is refused. ``runs`` is edited in place; returns whether anything joined.
+    """
+    joined_any = False
+    changed = True
+    while changed:
+        changed = False
+        for i, seg in enumerate(runs):
+            if seg.label != into:
+                continue
+            for j in (i - 1, i + 1):
+                if not 0 <= j < len(runs) or runs[j].label != source:
+                    continue
+                other = runs[j]
+                a, b = (seg, other) if j > i else (other, seg)  # a precedes b in beam order
+                if np.hypot(*(points[b.start] - points[a.stop - 1])) >= join_threshold[a.stop - 1]:
+                    continue
+                if np.hypot(*(points[b.stop - 1] - points[a.start])) > max_extent:
+                    continue
+                merged = Segment(a.start, b.stop, into, tuple(sorted(set(seg.sets) | {source})))
+                runs[min(i, j)] = merged
+                del runs[max(i, j)]
+                changed = joined_any = True
+                break
+            if changed:
+                break
+    return joined_any
+
+
+def recover_moving(runs: list[Segment], points: np.ndarray, join_threshold: np.ndarray, min_seed: int,
+                   min_points: int, max_extent: float, single_object_max_o: int) -> list[Segment]:
+    """Algorithms 2 and 3: the segments that are moving objects.
+
+    Algorithm 2: if M_C^s is not empty, Join(M_C^s, A_C^s) then Join(M_C^s, O_C^s).
+    Algorithm 3: if M_C^s is empty and O_C^s is not, and the scene holds a single moving
+    object (at most ``single_object_max_o`` O_C segments of ``min_points`` readings),
+    M_C^s ← O_C^s.
+
+    M segments of fewer than ``min_seed`` readings are noise and seed nothing.
+    """
+    runs = [r if r.label != MOVING or r.size >= min_seed else Segment(r.start, r.stop, -1, (-1,)) for r in runs]
+    if any(r.label == MOVING for r in runs):
+        join(runs, MOVING, STATIC, points, join_threshold, max_extent)
+        join(runs, MOVING, OCCLUDED, points, join_threshold, max_extent)
+        return [r for r in runs if r.label == MOVING]
+    occluded = [r for r in runs if r.label == OCCLUDED and r.size >= min_points]
+    if 0 < len(occluded) <= single_object_max_o:
+        return occluded
+    return []

@@ -1,0 +1,109 @@
+"""Stage 2: Algorithm 1. Readings not static are split into M, O and N by comparing ranges
+along the current scan's lines of sight."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW
+
+
+def bin_to_beams(points: np.ndarray, angle_min: float, angle_increment: float, n_beams: int) -> np.ndarray:
+    """Index of the current beam whose line of sight passes nearest each point, -1 outside the view.
+
+    Parameters
+    ----------
+    points : ndarray, shape (m, 2)
+        Points in the current sensor frame, metres.
+    """
+    bearing = np.arctan2(points[:, 1], points[:, 0])
+    # the offset from beam 0 in the scan's own direction, wrapped to one turn
+    offset = (bearing - angle_min) * np.sign(angle_increment)
+    offset = np.mod(offset + np.pi / 8, 2 * np.pi) - np.pi / 8  # a little before beam 0 stays negative
+    idx = np.rint(offset / abs(angle_increment)).astype(np.int64)
+    idx[(idx < 0) | (idx >= n_beams)] = -1
+    return idx
+
+
+def _nearest_per_beam(beam: np.ndarray, rng: np.ndarray, n_beams: int) -> np.ndarray:
+    """Per beam, the index of the nearest reading binned to it (-1 for none)."""
+    inside = np.flatnonzero(beam >= 0)
+    at_beam = np.full(n_beams, -1, dtype=np.int64)
+    if len(inside) == 0:
+        return at_beam
+    order = inside[np.lexsort((rng[inside], beam[inside]))]
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = beam[order][1:] != beam[order][:-1]
+    at_beam[beam[order][first]] = order[first]
+    return at_beam
+
+
+def _partner(beam_c: np.ndarray, at_beam: np.ndarray, window: int) -> np.ndarray:
+    """For each current beam, the reading on its line of sight, else the nearest within ``window`` beams."""
+    n_beams = len(at_beam)
+    partner = at_beam[beam_c]
+    for step in range(1, window + 1):
+        for sign in (-1, 1):
+            need = partner < 0
+            if not need.any():
+                return partner
+            j = np.clip(beam_c[need] + sign * step, 0, n_beams - 1)
+            partner[need] = at_beam[j]
+    return partner
+
+
+def scan_line_labels(beam_c: np.ndarray, range_c: np.ndarray, beam_p: np.ndarray, range_p: np.ndarray,
+                     n_beams: int, window: int, beam_all: np.ndarray | None = None,
+                     range_all: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Algorithm 1 on the non-static readings B_C and B_P.
+
+    Each B_C reading on beam i looks for a B_P reading binned to beam i, or failing that to
+    the nearest beam within ``window`` beams. With one: the nearer of the two is moving
+    (M) and the farther one occluded (O). Without: the current reading is out of the
+    previous scan's view (N_C). B_P readings that no B_C reading paired with are N_P.
+
+    Parameters
+    ----------
+    beam_c : ndarray of int, shape (n,)
+        Beam index of each B_C reading.
+    range_c : ndarray, shape (n,)
+        Its range, metres.
+    beam_p : ndarray of int, shape (m,)
+        Current beam each B_P reading is binned to (-1 outside the current view).
+    range_p : ndarray, shape (m,)
+        Its range from the current sensor origin, metres.
+
+    beam_all, range_all : ndarray, optional
+        Every valid previous reading (static ones too), binned and ranged the same way.
+        A B_C reading with no B_P partner is compared with these before it is called N:
+        a reading in front of a surface the previous scan saw on the same line of sight is
+        moving even though that surface is static (an object's edge against the
+        background), and only a line the previous scan did not see at all is out of view.
+
+    Returns
+    -------
+    label_c, label_p : ndarray of int, shapes (n,), (m,)
+        MOVING, OCCLUDED or OUT_OF_VIEW for each reading.
+    """
+    label_c = np.full(len(beam_c), OUT_OF_VIEW, dtype=np.int8)
+    label_p = np.full(len(beam_p), OUT_OF_VIEW, dtype=np.int8)
+    if len(beam_c) == 0:
+        return label_c, label_p
+    partner = _partner(beam_c, _nearest_per_beam(beam_p, range_p, n_beams), window)
+    has = partner >= 0
+    if beam_all is not None:
+        fallback = _partner(beam_c[~has], _nearest_per_beam(beam_all, range_all, n_beams), window)
+        seen = fallback >= 0
+        idx = np.flatnonzero(~has)[seen]
+        ahead = range_c[idx] < range_all[fallback[seen]]
+        label_c[idx[ahead]] = MOVING
+        label_c[idx[~ahead]] = OCCLUDED
+    nearer = has & (range_c < range_p[np.maximum(partner, 0)])
+    farther = has & (range_c > range_p[np.maximum(partner, 0)])
+    # current nearer: M_C and O_P; current farther: O_C and M_P
+    label_c[nearer] = MOVING
+    label_c[farther] = OCCLUDED
+    label_c[has & ~nearer & ~farther] = OCCLUDED  # equal ranges: not evidence of motion
+    label_p[partner[nearer]] = OCCLUDED
+    label_p[partner[farther]] = MOVING
+    return label_c, label_p
