@@ -7,26 +7,40 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 
-def closest_point_static(points_c: np.ndarray, points_p: np.ndarray, thr_c: np.ndarray,
-                         thr_p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def closest_point_static(tree_c: cKDTree, points_p_in_c: np.ndarray, thr_p: np.ndarray,
+                         tree_p: cKDTree, points_c_in_p: np.ndarray, thr_c: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray]:
     """Which readings of each scan have a reading of the other scan within their threshold.
+
+    Each scan's KD-tree is built once, in its own sensor frame, and reused for every
+    comparison; the other scan's readings are moved into that frame (a rigid motion, so
+    distances are unchanged).
 
     Parameters
     ----------
-    points_c : ndarray, shape (n, 2)
-        Valid readings of the current scan, current sensor frame, metres.
-    points_p : ndarray, shape (m, 2)
-        Valid readings of the previous scan, transformed into the current sensor frame.
-    thr_c, thr_p : ndarray, shapes (n,), (m,)
-        Δd_c of each reading, metres.
+    tree_c : cKDTree
+        The current scan's valid readings, current sensor frame.
+    points_p_in_c : ndarray, shape (m, 2)
+        The previous scan's valid readings in the current sensor frame, metres.
+    thr_p : ndarray, shape (m,)
+        Δd_c of each previous reading, metres.
+    tree_p : cKDTree
+        The previous scan's valid readings, previous sensor frame.
+    points_c_in_p : ndarray, shape (n, 2)
+        The current scan's valid readings in the previous sensor frame, metres.
+    thr_c : ndarray, shape (n,)
+        Δd_c of each current reading, metres.
 
     Returns
     -------
     static_c, static_p : ndarray of bool, shapes (n,), (m,)
         A_C and A_P.
     """
-    if len(points_c) == 0 or len(points_p) == 0:
-        return np.zeros(len(points_c), dtype=bool), np.zeros(len(points_p), dtype=bool)
-    d_c, _ = cKDTree(points_p).query(points_c, k=1)
-    d_p, _ = cKDTree(points_c).query(points_p, k=1)
+    n, m = len(points_c_in_p), len(points_p_in_c)
+    if n == 0 or m == 0:
+        return np.zeros(n, dtype=bool), np.zeros(m, dtype=bool)
+    # distances beyond the largest threshold come back as inf: the search stops early
+    d_c, _ = tree_p.query(points_c_in_p, k=1, distance_upper_bound=float(thr_c.max()))
+    d_p, _ = tree_c.query(points_p_in_c, k=1, distance_upper_bound=float(thr_p.max()))
     return d_c < thr_c, d_p < thr_p
+

@@ -11,6 +11,7 @@ from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from detection.closest import closest_point_static
 from detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
@@ -53,7 +54,7 @@ class DetectorParams:
     k_segment: float = 12.0
     segment_floor_m: float = 0.06
     scan_line_window: int = 1
-    compare_dt_s: tuple[float, ...] = (0.1,)
+    compare_dt_s: tuple[float, ...] = (0.15, 0.45)
     min_seed_points: int = 2
     min_object_points: int = 3
     max_object_size_m: float = 1.0
@@ -82,12 +83,19 @@ class Detection:
 class _Past:
     scan: Scan
     pose: Pose2D | None
+    tree: cKDTree  # the valid readings, in the scan's own sensor frame
 
 
-def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams) -> np.ndarray:
+def _tree(scan: Scan) -> cKDTree:
+    return cKDTree(scan.valid_points)
+
+
+def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
+               tree_c: cKDTree | None = None, tree_p: cKDTree | None = None) -> np.ndarray:
     """Labels of the current scan's readings from one comparison with an earlier scan.
 
-    ``rel`` is the earlier sensor pose seen from the current one (current_T_previous).
+    ``rel`` is the earlier sensor pose seen from the current one (current_T_previous);
+    ``tree_c``/``tree_p`` are the scans' KD-trees when the caller keeps them.
     """
     labels = np.zeros(scan.n_beams, dtype=np.int8)  # INVALID
     valid_c = np.flatnonzero(scan.valid)
@@ -97,9 +105,10 @@ def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams) -> n
     r_p = np.hypot(pts_p[:, 0], pts_p[:, 1])
     # 1. closest points → A_C, A_P
     static_c, static_p = closest_point_static(
-        pts_c, pts_p,
-        range_threshold(r_c, scan.resolution, params.k_closest, params.closest_floor_m),
-        range_threshold(r_p, prev.resolution, params.k_closest, params.closest_floor_m))
+        tree_c if tree_c is not None else _tree(scan), pts_p,
+        range_threshold(r_p, prev.resolution, params.k_closest, params.closest_floor_m),
+        tree_p if tree_p is not None else _tree(prev), rel.inverse().transform_points(pts_c),
+        range_threshold(r_c, scan.resolution, params.k_closest, params.closest_floor_m))
     labels[valid_c[static_c]] = STATIC
     # 2. Algorithm 1 on B_C, B_P: the previous readings binned to the current beams
     b_c = valid_c[~static_c]
@@ -164,7 +173,8 @@ class MovingObjectDetector:
         """
         p = self.params
         earlier = self._earlier(scan.stamp)
-        self._history.append(_Past(scan, pose))
+        tree = _tree(scan)
+        self._history.append(_Past(scan, pose, tree))
         while self._history and self._history[0].scan.stamp < scan.stamp - self._keep_s:
             self._history.popleft()
         if not earlier:
@@ -172,7 +182,7 @@ class MovingObjectDetector:
         pairs = []
         for past in earlier:
             rel = pose.between(past.pose) if pose is not None and past.pose is not None else Pose2D()
-            pairs.append(label_pair(scan, past.scan, rel, p))
+            pairs.append(label_pair(scan, past.scan, rel, p, tree, past.tree))
         labels = combine(pairs)
         # 3. segments of each set, over the valid readings in beam order
         valid = np.flatnonzero(scan.valid)

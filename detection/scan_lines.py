@@ -27,14 +27,11 @@ def bin_to_beams(points: np.ndarray, angle_min: float, angle_increment: float, n
 
 def _nearest_per_beam(beam: np.ndarray, rng: np.ndarray, n_beams: int) -> np.ndarray:
     """Per beam, the index of the nearest reading binned to it (-1 for none)."""
-    inside = np.flatnonzero(beam >= 0)
     at_beam = np.full(n_beams, -1, dtype=np.int64)
-    if len(inside) == 0:
-        return at_beam
-    order = inside[np.lexsort((rng[inside], beam[inside]))]
-    first = np.ones(len(order), dtype=bool)
-    first[1:] = beam[order][1:] != beam[order][:-1]
-    at_beam[beam[order][first]] = order[first]
+    inside = np.flatnonzero(beam >= 0)
+    # farthest first: where several readings share a beam, the nearest is written last and stays
+    order = inside[np.argsort(-rng[inside], kind="stable")]
+    at_beam[beam[order]] = order
     return at_beam
 
 
@@ -47,7 +44,7 @@ def _partner(beam_c: np.ndarray, at_beam: np.ndarray, window: int) -> np.ndarray
             need = partner < 0
             if not need.any():
                 return partner
-            j = np.clip(beam_c[need] + sign * step, 0, n_beams - 1)
+            j = np.minimum(np.maximum(beam_c[need] + sign * step, 0), n_beams - 1)
             partner[need] = at_beam[j]
     return partner
 
@@ -98,8 +95,10 @@ def scan_line_labels(beam_c: np.ndarray, range_c: np.ndarray, beam_p: np.ndarray
         ahead = range_c[idx] < range_all[fallback[seen]]
         label_c[idx[ahead]] = MOVING
         label_c[idx[~ahead]] = OCCLUDED
-    nearer = has & (range_c < range_p[np.maximum(partner, 0)])
-    farther = has & (range_c > range_p[np.maximum(partner, 0)])
+    r_partner = np.full(len(beam_c), np.nan)
+    r_partner[has] = range_p[partner[has]]
+    nearer = has & (range_c < r_partner)
+    farther = has & (range_c > r_partner)
     # current nearer: M_C and O_P; current farther: O_C and M_P
     label_c[nearer] = MOVING
     label_c[farther] = OCCLUDED

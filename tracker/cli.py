@@ -56,6 +56,7 @@ def _build_parser() -> argparse.ArgumentParser:
                      help="a ROS 1 .bag, a ROS 2 bag folder, or an .mcap file")
     run.add_argument("--topic", help="LaserScan topic (default: the only one)")
     run.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
+    run.add_argument("--detections", metavar="FILE.csv", help="write the moving objects of every scan")
 
     ev = sub.add_parser("evaluate", help="score a tracks CSV against ground truth (CLEAR MOT, IDF1, OSPA)")
     ev.add_argument("tracks", metavar="TRACKS.csv", help="needs the columns scan_index,track_id,x,y")
@@ -87,12 +88,27 @@ def _progress(total: int, quiet: bool):
                 delay=2.0, leave=False, dynamic_ncols=True)
 
 
+def _print_v_min(params, resolution: float) -> None:
+    from detection.detector import v_min
+
+    for dt, speeds in v_min(params, resolution).items():
+        print(f"V_min = Δd_c/Δt for Δt {dt:g} s: " + ", ".join(
+            f"{v:.2f} m/s at {r:g} m" for v, r in zip(speeds, (1, 3, 5))))
+
+
 def _cmd_run(args) -> int:
-    from tracker.config import load_config
+    import contextlib
+
+    from detection.detector import MovingObjectDetector
+    from tracker.config import dump_config, load_config
+    from tracker.io import detections_csv
+    from tracker.io.atomic import atomic_output, check_writable
     from tracker.io.recording import Recording
     from tracker.scan_checks import ScanChecker
 
     config = load_config(args.config)
+    if args.detections:
+        check_writable(args.detections)
     log = logging.getLogger(PROG)
     t0 = time.perf_counter()
     if args.input is None:
@@ -102,9 +118,15 @@ def _cmd_run(args) -> int:
         source = SimulatedSource(DEFAULT_SCENE)
     else:
         source = Recording(args.input, args.topic, config.odometry)
-    with source as rec:
+    outputs = contextlib.ExitStack()
+    with source as rec, outputs:
+        det_file = outputs.enter_context(atomic_output(args.detections)) if args.detections else None
+        if det_file:
+            detections_csv.write_header(det_file)
+        detector = MovingObjectDetector(config.detector.params())
+        _print_v_min(detector.params, rec.resolution)
         checker = ScanChecker(config.scan_checks.stamp_jump_periods, config.scan_checks.beam_count_confirm)
-        used = skipped = restarts = with_pose = 0
+        used = skipped = restarts = with_pose = n_objects = 0
         first_stamp = last_stamp = None
         path_m = 0.0
         last_pose = None
@@ -120,6 +142,12 @@ def _cmd_run(args) -> int:
                 used += 1
                 restarts += verdict.restart
                 scan = record.scan
+                if verdict.restart:
+                    detector.reset()
+                found = detector.detect(scan, record.pose)
+                n_objects += len(found.objects)
+                if det_file:
+                    detections_csv.write_rows(det_file, record.index, scan.stamp, found.objects)
                 first_stamp = scan.stamp if first_stamp is None else first_stamp
                 last_stamp = scan.stamp
                 if record.pose is not None:
@@ -139,6 +167,11 @@ def _cmd_run(args) -> int:
         total = used + skipped
         print(f"scans: {total} read, {used} used, {skipped} skipped, {restarts} history restarts; "
               f"{span:.1f} s of recording in {elapsed:.2f} s ({total / max(elapsed, 1e-9):.0f} scans/s)")
+        print(f"moving objects: {n_objects} ({n_objects / max(used, 1):.2f} per scan)"
+              + (f" written to {args.detections}" if args.detections else ""))
+        if args.detections:
+            with atomic_output(f"{args.detections}.config.yaml") as fh:
+                fh.write(dump_config(config))
     return 0
 
 

@@ -46,14 +46,40 @@ class ScanChecksConfig:
 
 
 @dataclass(frozen=True)
+class DetectorConfig:
+    """The paper's detector; see :class:`detection.detector.DetectorParams`."""
+
+    compare_dt_s: tuple = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    k_closest: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
+    closest_floor_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
+    k_segment: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
+    segment_floor_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
+    scan_line_window: int = field(metadata=_spec(lo=0, hi=100))
+    min_seed_points: int = field(metadata=_spec(lo=1, hi=10000))
+    min_object_points: int = field(metadata=_spec(lo=1, hi=10000))
+    max_object_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
+    single_object_max_o: int = field(metadata=_spec(lo=0, hi=10000))
+
+    def params(self):
+        """The detector's own parameter object."""
+        from detection.detector import DetectorParams
+        return DetectorParams(**dataclasses.asdict(self))
+
+
+@dataclass(frozen=True)
 class Config:
     """The whole resolved configuration."""
 
     odometry: OdometryConfig
     scan_checks: ScanChecksConfig
+    detector: DetectorConfig
 
     def to_dict(self) -> dict:
-        return dataclasses.asdict(self)
+        def plain(v):
+            if isinstance(v, dict):
+                return {k: plain(x) for k, x in v.items()}
+            return list(v) if isinstance(v, tuple) else v
+        return plain(dataclasses.asdict(self))
 
 
 def _default_text() -> str:
@@ -76,6 +102,10 @@ def _merge(base: dict, override: dict, where: str) -> dict:
 
 
 def _check_value(name: str, value: Any, typ: type, spec: dict) -> Any:
+    if typ is tuple:  # a non-empty list of numbers, each checked against the range
+        if not isinstance(value, list) or not value:
+            raise InputError(f"configuration key '{name}' must be a non-empty list of numbers, got {value!r}")
+        return tuple(_check_value(name, v, float, spec) for v in value)
     if typ is bool:
         if not isinstance(value, bool):
             raise InputError(f"configuration key '{name}' must be true or false, got {value!r}")

@@ -122,3 +122,33 @@ def test_console_script_is_installed_beside_the_interpreter():
     assert exe is not None, "pip install did not put people-tracker next to python"
     proc = run_cli("--help")
     assert proc.returncode == 0 and "run" in proc.stdout and "evaluate" in proc.stdout and "simulate" in proc.stdout
+
+
+def test_run_writes_the_detections_contract_and_the_resolved_config(tmp_path):
+    import csv
+    out = tmp_path / "det.csv"
+    proc = run_cli("run", "--detections", str(out))  # the built-in crossing scene
+    assert proc.returncode == 0, proc.stderr
+    assert "V_min = Δd_c/Δt for Δt 0.15 s" in proc.stdout and "at 3 m" in proc.stdout
+    rows = list(csv.DictReader(out.open()))
+    assert list(rows[0].keys()) == ["scan_index", "stamp", "object_id", "first_beam", "last_beam", "n_points",
+                                    "x", "y", "width", "length", "recovered_from"]
+    assert len(rows) > 100
+    for r in rows:
+        assert float(r["width"]) <= float(r["length"])
+        assert int(r["first_beam"]) <= int(r["last_beam"]) < 772
+        assert r["recovered_from"] in ("M", "M+A", "M+O", "M+A+O", "O")
+    assert "compare_dt_s" in (tmp_path / "det.csv.config.yaml").read_text()
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".part")]
+
+
+def test_unwritable_detections_path_fails_before_any_work(tmp_path, good_bag):
+    proc = run_cli("run", str(good_bag), "--detections", str(tmp_path / "missing" / "d.csv"))
+    assert_one_line_error(proc, "does not exist")
+
+
+def test_a_failed_run_leaves_no_output(tmp_path):
+    out = tmp_path / "d.csv"
+    (tmp_path / "bad.bag").write_bytes(b"#ROSBAG V2.0\n" + b"\x00" * 500)
+    proc = run_cli("run", str(tmp_path / "bad.bag"), "--detections", str(out))
+    assert proc.returncode == 2 and not out.exists() and list(tmp_path.iterdir()) == [tmp_path / "bad.bag"]

@@ -99,6 +99,7 @@ class Recording:
             first = self._first_scan()
             self.laser_frame = first.frame_id
             self.n_beams = first.n_beams
+            self.resolution = first.resolution  # rad, of the first scan
             self.pose_source = self._guard(lambda: choose_pose_source(self._reader, self.laser_frame, odometry))
         except BaseException:
             self._reader.close()

@@ -41,6 +41,7 @@ class SimulatedSource:
         self.topic = "/scan"
         self.laser_frame = self.sim.laser.frame_id
         self.n_beams = self.sim.laser.n_beams
+        self.resolution = abs(self.sim.laser.angle_increment)
         self.odometry = "simulated odometry + mount"
         self.fixed_frame = "odom"
         self.truths = []  # the Truth of every scan produced so far

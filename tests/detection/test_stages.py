@@ -1,0 +1,139 @@
+"""The detector's stages one by one, on hand-made inputs."""
+
+import math
+
+import numpy as np
+import pytest
+
+from detection.closest import closest_point_static
+from detection.detector import DetectorParams, MovingObjectDetector, combine, label_pair
+from detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
+from detection.objects import describe, recovered_name
+from detection.recover import join, recover_moving
+from detection.scan_lines import bin_to_beams, scan_line_labels
+from detection.segments import Segment, split_runs
+from detection.thresholds import range_threshold
+from models.pose import Pose2D
+from models.scan import Scan
+
+
+def test_threshold_grows_with_range_and_resolution_and_has_a_floor():
+    thr = range_threshold(np.array([0.1, 2.0, 4.0]), math.radians(0.5), k=4.0, floor=0.02)
+    assert thr[0] == 0.02
+    assert thr[2] == pytest.approx(2 * thr[1]) and thr[1] == pytest.approx(4 * math.tan(math.radians(0.25)) * 2)
+
+
+def test_closest_points_are_static_both_ways():
+    from scipy.spatial import cKDTree
+    c = np.array([[1.0, 0.0], [2.0, 0.0], [5.0, 5.0]])
+    p = np.array([[1.01, 0.0], [2.2, 0.0]])
+    # both scans in one frame here: each tree queried with the other scan's points
+    sc, sp = closest_point_static(cKDTree(c), p, np.full(2, 0.05), cKDTree(p), c, np.full(3, 0.05))
+    assert sc.tolist() == [True, False, False] and sp.tolist() == [True, False]
+
+
+@pytest.mark.parametrize("inc", [math.radians(1), -math.radians(1)])
+def test_binning_to_beams_follows_the_scan_direction(inc):
+    amin = -math.pi / 2 if inc > 0 else math.pi / 2
+    pts = np.array([[1.0, 0.0], [0.0, 1.0], [0.0, -1.0], [-1.0, 0.0]])
+    idx = bin_to_beams(pts, amin, inc, 181)
+    straight, left, right = (90, 180, 0) if inc > 0 else (90, 0, 180)
+    assert idx.tolist() == [straight, left, right, -1]
+
+
+def test_algorithm1_nearer_is_moving_farther_is_occluded_and_unseen_is_out_of_view():
+    beam_c = np.array([10, 11, 12, 50])
+    range_c = np.array([2.0, 5.0, 3.0, 4.0])
+    beam_p = np.array([10, 11, 12])
+    range_p = np.array([4.0, 3.0, 3.0])
+    lc, lp = scan_line_labels(beam_c, range_c, beam_p, range_p, 100, window=1)
+    assert lc.tolist() == [MOVING, OCCLUDED, OCCLUDED, OUT_OF_VIEW]
+    # O_P behind M_C; M_P in front of O_C; equal ranges pair nothing
+    assert lp.tolist() == [OCCLUDED, MOVING, OUT_OF_VIEW]
+
+
+def test_algorithm1_falls_back_to_static_previous_readings_on_the_line_of_sight():
+    # no B_P at all (everything previous was static): an object in front of the wall is moving
+    lc, _ = scan_line_labels(np.array([5, 6]), np.array([2.0, 9.0]), np.zeros(0, int), np.zeros(0), 20, 1,
+                             beam_all=np.array([5, 6]), range_all=np.array([8.0, 8.0]))
+    assert lc.tolist() == [MOVING, OCCLUDED]
+
+
+def test_segments_split_on_label_change_and_on_gaps():
+    labels = np.array([STATIC, STATIC, MOVING, MOVING, MOVING, STATIC])
+    pts = np.array([[0, 0], [0, 0.05], [0, 0.1], [0, 0.15], [0, 0.5], [0, 0.55]], dtype=float)
+    runs = split_runs(labels, pts, np.full(6, 0.1))
+    assert [(r.start, r.stop, r.label) for r in runs] == [(0, 2, STATIC), (2, 4, MOVING), (4, 5, MOVING), (5, 6, STATIC)]
+
+
+def test_join_absorbs_close_neighbours_once_and_respects_the_size_limit():
+    pts = np.column_stack([np.zeros(10), np.arange(10) * 0.05])
+    thr = np.full(10, 0.08)
+    runs = [Segment(0, 3, STATIC, (STATIC,)), Segment(3, 6, MOVING, (MOVING,)), Segment(6, 10, OCCLUDED, (OCCLUDED,))]
+    assert join(runs, MOVING, STATIC, pts, thr, max_extent=5.0)
+    assert [(r.start, r.stop, r.label) for r in runs] == [(0, 6, MOVING), (6, 10, OCCLUDED)]
+    assert not join(runs, MOVING, STATIC, pts, thr, max_extent=5.0)
+    runs2 = [Segment(0, 3, MOVING, (MOVING,)), Segment(3, 10, STATIC, (STATIC,))]
+    assert not join(runs2, MOVING, STATIC, pts, thr, max_extent=0.2)  # would be 0.45 m long
+
+
+def test_algorithm3_replaces_only_under_the_single_object_condition():
+    pts = np.column_stack([np.zeros(12), np.arange(12) * 0.05])
+    thr = np.full(12, 0.01)  # nothing joins
+    one_o = [Segment(0, 6, STATIC, (STATIC,)), Segment(6, 10, OCCLUDED, (OCCLUDED,))]
+    assert [(r.start, r.stop) for r in recover_moving(one_o, pts, thr, 2, 3, 1.0, 1)] == [(6, 10)]
+    two_o = [Segment(0, 4, OCCLUDED, (OCCLUDED,)), Segment(4, 6, STATIC, (STATIC,)), Segment(6, 10, OCCLUDED, (OCCLUDED,))]
+    assert recover_moving(two_o, pts, thr, 2, 3, 1.0, 1) == []
+
+
+def test_describe_gives_hull_centroid_and_a_rectangle_with_width_below_length():
+    ang = np.linspace(-np.pi / 2, np.pi / 2, 9)
+    pts = np.column_stack([2.0 - 0.1 * np.cos(ang), 0.1 * np.sin(ang)])  # the near half of a leg
+    o = describe(7, np.arange(20, 29), pts, (MOVING, STATIC))
+    assert o.first_beam == 20 and o.last_beam == 28 and o.n_points == 9 and o.recovered_from == "M+A"
+    assert o.width <= o.length and o.length == pytest.approx(0.2, abs=1e-6) and o.width == pytest.approx(0.1, abs=1e-6)
+    assert 1.9 < o.x < 1.96 and abs(o.y) < 1e-9
+    line = describe(8, np.arange(3), np.array([[1.0, 0], [1.0, 0.1], [1.0, 0.2]]), (OCCLUDED,))
+    assert line.width == 0.0 and line.length == pytest.approx(0.2) and line.recovered_from == "O"
+
+
+def test_recovered_names():
+    assert recovered_name((MOVING,)) == "M" and recovered_name((OCCLUDED, MOVING, STATIC)) == "M+A+O"
+
+
+def test_combining_comparisons_prefers_motion():
+    a = np.array([INVALID, STATIC, STATIC, OUT_OF_VIEW, STATIC])
+    b = np.array([INVALID, MOVING, STATIC, OUT_OF_VIEW, OCCLUDED])
+    assert combine([a, b]).tolist() == [INVALID, MOVING, STATIC, OUT_OF_VIEW, OCCLUDED]
+
+
+def _wall_scan(stamp, blob_at=None, n=181):
+    ang = np.radians(np.linspace(-90, 90, n))
+    r = np.full(n, 5.0) / np.maximum(np.cos(ang), 0.2)  # a wall at x = 5 (clipped at the sides)
+    if blob_at is not None:
+        r[blob_at - 3: blob_at + 4] = 2.0
+    return Scan(r, ang[0], ang[1] - ang[0], 0.05, 30.0, stamp=stamp)
+
+
+def test_a_moving_sensor_uses_the_pose_and_a_still_wall_stays_static():
+    # the sensor moves 0.5 m towards the wall between scans: without the pose the wall looks moving
+    s0 = _wall_scan(0.0)
+    ang = s0.angles
+    r1 = np.full(181, 4.5) / np.maximum(np.cos(ang), 0.2 * 5.0 / 4.5)
+    s1 = Scan(r1, s0.angle_min, s0.angle_increment, 0.05, 30.0, stamp=0.1)
+    params = DetectorParams(compare_dt_s=(0.1,))
+    with_pose = label_pair(s1, s0, Pose2D(0.5, 0, 0).between(Pose2D(0, 0, 0)), params)
+    assert (with_pose[40:140] == STATIC).all()
+    without = label_pair(s1, s0, Pose2D(), params)
+    assert (without[40:140] == MOVING).mean() > 0.9
+
+
+def test_detector_finds_an_object_that_appears_and_keeps_history_by_time():
+    det = MovingObjectDetector(DetectorParams(compare_dt_s=(0.1,)))
+    assert det.detect(_wall_scan(0.0)).objects == []
+    d = det.detect(_wall_scan(0.1, blob_at=90))
+    assert len(d.objects) == 1 and d.objects[0].first_beam == 87 and d.objects[0].last_beam == 93
+    assert d.objects[0].x == pytest.approx(2.0, abs=0.05) and d.compared_dt_s == pytest.approx((0.1,))
+    det.reset()
+    assert det.detect(_wall_scan(0.2, blob_at=90)).compared_dt_s == ()
+
