@@ -4,11 +4,13 @@ A person's torso moves along a polyline of waypoints at the walker's speed, paus
 told. The legs are placed by the torso's arc length ``s`` along the path, so a paused
 person's legs stand still and a walking person's stance leg does too:
 
-* footprints lie every ``step_length`` metres along the path, alternately left and right
-  of it by half the leg spacing;
-* while the torso goes from footprint ``k`` to ``k + 1``, one leg stands on footprint ``k``
+* footprints lie every ``step_length`` metres along the path, at ``(k + ½)·step_length``,
+  alternately left and right of it by half the leg spacing;
+* while the torso goes from ``k·L`` to ``(k + 1)·L``, one leg stands on footprint ``k``
   (stance) and the other swings from footprint ``k - 1`` to ``k + 1``: twice the distance in
-  the same time, so at about twice the walking speed;
+  the same time, so at about twice the walking speed. The torso is thus midway between
+  the feet when a foot lands and right above the standing foot at mid-step, and always at
+  the legs' midpoint;
 * the cadence (steps per second) is ``speed / step_length``, so it follows the speed.
 
 Pauses start at the middle of a step, where the swinging leg passes the standing one, so a
@@ -160,7 +162,7 @@ class Walker:
         return (self.torso(t + dt) - self.torso(t - dt)) / (2 * dt)
 
     def _footprint(self, k: int) -> np.ndarray:
-        p, u = self._at(k * self.body.step_length)
+        p, u = self._at((k + 0.5) * self.body.step_length)
         side = 1.0 if k % 2 == 0 else -1.0  # even footprints left of the path, odd right
         normal = np.array([-u[1], u[0]])
         return p + side * 0.5 * self.body.leg_spacing * normal

@@ -63,7 +63,60 @@ class DetectorConfig:
     def params(self):
         """The detector's own parameter object."""
         from detection.detector import DetectorParams
-        return DetectorParams(**dataclasses.asdict(self))
+        return _params_of(self, DetectorParams)
+
+
+def _params_of(section, cls):
+    return cls(**dataclasses.asdict(section))
+
+
+@dataclass(frozen=True)
+class PairingConfig:
+    """Leg pairing; see :class:`tracker.pairing.PairingParams`."""
+
+    max_leg_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
+    max_person_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    max_leg_separation_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
+    sigma_pair_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    sigma_single_leg_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    sigma_blob_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+
+    def params(self):
+        from tracker.pairing import PairingParams
+        return _params_of(self, PairingParams)
+
+
+@dataclass(frozen=True)
+class TracksConfig:
+    """Track filter and lifecycle; see :class:`tracker.tracks.TrackParams`."""
+
+    accel_std_mps2: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
+    init_speed_std_mps: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
+    confirm_hits: int = field(metadata=_spec(lo=1, hi=1000))
+    confirm_window: int = field(metadata=_spec(lo=1, hi=1000))
+    max_coast_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3600.0))
+    max_static_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=86400.0))
+    max_position_std_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
+
+    def params(self):
+        from tracker.tracks import TrackParams
+        return _params_of(self, TrackParams)
+
+
+@dataclass(frozen=True)
+class AssociationConfig:
+    """Association and static support; see :class:`tracker.people_tracker.AssociationParams`."""
+
+    method: str = field(metadata=_spec(choices=("gnn", "nn")))
+    gate_chi2: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    spawn_exclusion_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
+    support_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
+    support_sigma_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    support_min_points: int = field(metadata=_spec(lo=1, hi=10000))
+
+    def params(self):
+        from tracker.people_tracker import AssociationParams
+        return _params_of(self, AssociationParams)
 
 
 @dataclass(frozen=True)
@@ -73,6 +126,9 @@ class Config:
     odometry: OdometryConfig
     scan_checks: ScanChecksConfig
     detector: DetectorConfig
+    pairing: PairingConfig
+    tracks: TracksConfig
+    association: AssociationConfig
 
     def to_dict(self) -> dict:
         def plain(v):

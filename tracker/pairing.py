@@ -1,0 +1,100 @@
+"""Leg pairing: moving objects (legs, merged legs, bodies) become person candidates.
+
+Two leg-sized objects closer than a stride pair into a person at their midpoint (the
+torso). A lone leg is a candidate too, with a larger measurement uncertainty, and so is an
+object too wide for a leg but person-sized (two legs merged, a body). Anything larger is
+not a person.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class PairingParams:
+    """Sizes in metres (from the person model: legs 5–8 cm in radius, up to a stride apart).
+
+    Attributes
+    ----------
+    max_leg_size_m : float
+        Longest side of an object that can be one leg.
+    max_person_size_m : float
+        Longest side of an object that can be a person (two legs merged or a body).
+    max_leg_separation_m : float
+        Largest distance between two legs of one person (a stride).
+    sigma_pair_m, sigma_single_leg_m, sigma_blob_m : float
+        Standard deviation of the torso position measured from a leg pair, one leg, or a
+        person-sized object.
+    """
+
+    max_leg_size_m: float = 0.3
+    max_person_size_m: float = 0.8
+    max_leg_separation_m: float = 0.8
+    sigma_pair_m: float = 0.08
+    sigma_single_leg_m: float = 0.2
+    sigma_blob_m: float = 0.12
+
+
+@dataclass(frozen=True, eq=False)
+class PersonCandidate:
+    """A possible person in one scan.
+
+    Attributes
+    ----------
+    x, y : float
+        Torso position in the world frame, metres.
+    sigma : float
+        Standard deviation of that position, metres (isotropic).
+    kind : str
+        ``pair``, ``leg``, ``blob`` (from moving objects) or ``static`` (static support).
+    object_ids : tuple of int
+        The moving objects it was made from.
+    """
+
+    x: float
+    y: float
+    sigma: float
+    kind: str
+    object_ids: tuple[int, ...] = ()
+
+    @property
+    def R(self) -> np.ndarray:
+        """Measurement covariance, m²."""
+        return np.eye(2) * self.sigma ** 2
+
+
+def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: PairingParams) -> list[PersonCandidate]:
+    """Person candidates from moving objects.
+
+    Parameters
+    ----------
+    xy : ndarray, shape (k, 2)
+        Object centroids in the world frame, metres.
+    sizes : ndarray, shape (k,)
+        Longest side of each object's bounding rectangle, metres.
+    ids : list of int
+        Object ids.
+    """
+    legs = np.flatnonzero(sizes <= params.max_leg_size_m)
+    blobs = np.flatnonzero((sizes > params.max_leg_size_m) & (sizes <= params.max_person_size_m))
+    out = [PersonCandidate(float(xy[i, 0]), float(xy[i, 1]), params.sigma_blob_m, "blob", (ids[i],)) for i in blobs]
+    paired = set()
+    if len(legs) >= 2:
+        p = xy[legs]
+        d = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
+        a, b = np.triu_indices(len(legs), k=1)
+        close = d[a, b] <= params.max_leg_separation_m
+        a, b = a[close], b[close]
+        for k in np.argsort(d[a, b], kind="stable"):  # nearest pairs first, each leg once
+            i, j = int(legs[a[k]]), int(legs[b[k]])
+            if i in paired or j in paired:
+                continue
+            mid = 0.5 * (xy[i] + xy[j])
+            out.append(PersonCandidate(float(mid[0]), float(mid[1]), params.sigma_pair_m, "pair", (ids[i], ids[j])))
+            paired.update((i, j))
+    out += [PersonCandidate(float(xy[i, 0]), float(xy[i, 1]), params.sigma_single_leg_m, "leg", (ids[i],))
+            for i in legs if i not in paired]
+    return out

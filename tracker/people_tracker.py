@@ -1,0 +1,201 @@
+"""The people tracker: scans in, one track per person out.
+
+:class:`PeopleTracker` is the object to embed in a robot's loop or a ROS node::
+
+    tracker = PeopleTracker.from_config(load_config())
+    for scan, pose in source:
+        tracks = tracker.step(scan, pose)   # confirmed people, coasting ones included
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from detection.detector import Detection, DetectorParams, MovingObjectDetector
+from models.pose import Pose2D
+from models.scan import Scan
+from tracker.association import associate, mahalanobis_costs
+from tracker.following import TargetSelector
+from tracker.pairing import PairingParams, PersonCandidate, pair_legs
+from tracker.static_support import static_support
+from tracker.tracks import Track, TrackParams, TrackState
+
+
+@dataclass(frozen=True)
+class AssociationParams:
+    """Attributes
+    ----------
+    method : {'gnn', 'nn'}
+        Global nearest neighbour (optimal assignment) or greedy nearest neighbour.
+    gate_chi2 : float
+        Largest squared Mahalanobis distance of a match (9.21: 99 % for 2 dof).
+    spawn_exclusion_m : float
+        A candidate left over within this distance of a track starts no new track (the
+        other leg of a tracked person, say).
+    support_radius_m, support_sigma_m, support_min_points : float, float, int
+        Static support: how near the prediction readings must be (m), the standard
+        deviation of the position they give (m), and how many are needed.
+    """
+
+    method: str = "gnn"
+    gate_chi2: float = 9.21
+    spawn_exclusion_m: float = 0.6
+    support_radius_m: float = 0.35
+    support_sigma_m: float = 0.12
+    support_min_points: int = 3
+
+
+@dataclass(frozen=True, eq=False)
+class StepResult:
+    """Everything one step produced, for sinks (files, visualisation, metrics)."""
+
+    tracks: list[Track]
+    detection: Detection
+    candidates: list[PersonCandidate]
+    pose: Pose2D
+
+
+class PeopleTracker:
+    """Detector → leg pairing → Kalman tracks with association, lifecycle and following.
+
+    Parameters
+    ----------
+    detector, pairing, tracks, association : parameter objects
+    follow : 'auto', a track id, or None
+        Which person to follow (see :class:`~tracker.following.TargetSelector`).
+    """
+
+    def __init__(self, detector: DetectorParams | None = None, pairing: PairingParams | None = None,
+                 tracks: TrackParams | None = None, association: AssociationParams | None = None,
+                 follow: str | int | None = None) -> None:
+        self.detector = MovingObjectDetector(detector or DetectorParams())
+        self.pairing = pairing or PairingParams()
+        self.track_params = tracks or TrackParams()
+        self.assoc = association or AssociationParams()
+        self.selector = TargetSelector(follow) if follow is not None else None
+        self._tracks: list[TrackState] = []
+        self._next_id = 1
+        self.last: StepResult | None = None
+
+    @classmethod
+    def from_config(cls, config, follow: str | int | None = None) -> "PeopleTracker":
+        """A tracker from a resolved :class:`tracker.config.Config`."""
+        return cls(config.detector.params(), config.pairing.params(), config.tracks.params(),
+                   config.association.params(), follow)
+
+    def reset(self) -> None:
+        """Forget the scan history (a stamp jump, a new scanner); tracks coast on."""
+        self.detector.reset()
+
+    def step(self, scan: Scan, pose: Pose2D | None = None) -> list[Track]:
+        """Process one scan; return the confirmed tracks (coasting ones included).
+
+        Parameters
+        ----------
+        scan : Scan
+        pose : Pose2D, optional
+            Sensor pose in the world (fixed) frame at the scan stamp; without one the
+            sensor frame is the world frame.
+        """
+        world = pose or Pose2D()
+        detection = self.detector.detect(scan, pose)  # 1. moving objects (sensor frame)
+        candidates = self._candidates(detection, world)  # 2. legs paired into people (world frame)
+        for t in self._tracks:  # 3. predict every track to the scan time
+            t.predict(scan.stamp)
+        matched = self._associate(candidates)  # 4. associate candidates to tracks
+        for ti, ci in matched:  # 5. update the matched tracks
+            c = candidates[ci]
+            self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
+        self._support(scan, world, {ti for ti, _ in matched})  # 6. static support for the unmatched
+        for t in self._tracks:
+            t.record(t.updated_now)
+        self._initiate(candidates, {ci for _, ci in matched}, scan.stamp)  # 7. new tentative tracks
+        self._delete(scan.stamp)  # 8. delete what the lifecycle rules end
+        target = self._follow(world, scan.stamp)  # 9. the followed person
+        reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.confirmed]
+        self.last = StepResult(reported, detection, candidates, world)
+        return reported
+
+    def _candidates(self, detection: Detection, world: Pose2D) -> list[PersonCandidate]:
+        objs = detection.objects
+        if not objs:
+            return []
+        xy = world.transform_points(np.array([(o.x, o.y) for o in objs]))
+        return pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing)
+
+    def _associate(self, candidates: list[PersonCandidate]) -> list[tuple[int, int]]:
+        if not self._tracks or not candidates:
+            return []
+        means = np.array([t.position for t in self._tracks])
+        covs = np.array([t.position_cov for t in self._tracks])
+        z = np.array([(c.x, c.y) for c in candidates])
+        R = np.array([c.R for c in candidates])
+        cost = mahalanobis_costs(means, covs, z, R)
+        # confirmed tracks choose first: a tentative track never takes a confirmed one's candidate
+        confirmed = np.array([t.confirmed for t in self._tracks])
+        pairs = associate(np.where(confirmed[:, None], cost, np.inf), self.assoc.gate_chi2, self.assoc.method)
+        taken_c = {c for _, c in pairs}
+        rest = np.where(~confirmed[:, None], cost, np.inf)
+        rest[:, list(taken_c)] = np.inf
+        return pairs + associate(rest, self.assoc.gate_chi2, self.assoc.method)
+
+    def _support(self, scan: Scan, world: Pose2D, matched: set[int]) -> None:
+        idle = [i for i, t in enumerate(self._tracks) if t.confirmed and i not in matched]
+        if not idle:
+            return
+        d = self.detector.params
+        found = static_support(np.array([self._tracks[i].position for i in idle]), world, scan, d.k_segment,
+                               d.segment_floor_m, self.assoc.support_radius_m, self.pairing.max_person_size_m,
+                               self.assoc.support_min_points)
+        R = np.eye(2) * self.assoc.support_sigma_m ** 2
+        for i, z in zip(idle, found):
+            if z is not None:
+                self._tracks[i].update(z, R, moving=False)
+
+    def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float) -> None:
+        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
+        for ci, c in enumerate(candidates):
+            if ci in used:
+                continue
+            if len(known) and np.hypot(*(known - (c.x, c.y)).T).min() < self.assoc.spawn_exclusion_m:
+                continue
+            self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params))
+            known = np.vstack([known, [c.x, c.y]])
+            self._next_id += 1
+
+    def _delete(self, stamp: float) -> None:
+        keep = []
+        for t in self._tracks:
+            if t.dead():
+                if self.selector is not None and t.track_id == self.selector.target:
+                    self.selector.lost(stamp, t.position)
+                continue
+            keep.append(t)
+        self._tracks = keep
+
+    def _follow(self, world: Pose2D, stamp: float) -> int | None:
+        if self.selector is None:
+            return None
+        confirmed = {t.track_id: t.position for t in self._tracks if t.confirmed}
+        if self.selector.target is not None and self.selector.target not in confirmed:
+            young = {t.track_id: t.position for t in self._tracks
+                     if t.confirmed and t.track_id > self.selector.target and stamp - t.born < 2.0}
+            new_id = self.selector.reacquire(stamp, young)
+            if new_id is not None:
+                for t in self._tracks:
+                    if t.track_id == new_id:
+                        t.track_id = self.selector.target  # the person keeps their id
+                confirmed = {t.track_id: t.position for t in self._tracks if t.confirmed}
+        return self.selector.choose(confirmed, world)
+
+
+def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:
+    """Positions of tracks in the sensor frame, shape (t, 2), metres."""
+    if not tracks:
+        return np.zeros((0, 2))
+    return pose.inverse().transform_points(np.array([(t.x, t.y) for t in tracks]))
+
+
+__all__ = ["AssociationParams", "PeopleTracker", "StepResult", "tracks_in_sensor_frame"]

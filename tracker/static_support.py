@@ -1,0 +1,63 @@
+"""Static support: keeping a person through stance phases, occlusion and pauses.
+
+A standing leg, a paused person and a briefly occluded one are not moving, so the
+detector does not report them. For a confirmed track that got no moving candidate, the
+scan's own readings near its prediction are looked at: the segments (all readings, any
+set) that come within ``radius`` of the prediction are united, and if together they are
+person-sized they support the track at their centre — the paper's Join with A_C, lifted
+from one scan to a track. Static support never starts a track, and a track kept only by
+it is deleted after ``max_static_s`` (see :class:`~tracker.tracks.TrackParams`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from detection.segments import split_runs
+from detection.thresholds import range_threshold
+from models.pose import Pose2D
+from models.scan import Scan
+
+
+def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_segment: float,
+                   segment_floor_m: float, radius_m: float, max_size_m: float,
+                   min_points: int) -> list[np.ndarray | None]:
+    """For each predicted position (world frame, m), a supporting position or None.
+
+    Parameters
+    ----------
+    predictions_world : ndarray, shape (t, 2)
+    pose : Pose2D
+        The sensor pose in the world frame.
+    scan : Scan
+    k_segment, segment_floor_m : float
+        The detector's segment threshold (the readings' spacing within one object).
+    radius_m : float
+        How close to the prediction a segment must come, metres.
+    max_size_m : float
+        Largest extent (bounding-box diagonal) of a person, metres.
+    min_points : int
+        Fewest readings that support a person.
+    """
+    out: list[np.ndarray | None] = [None] * len(predictions_world)
+    if len(predictions_world) == 0 or scan.n_valid == 0:
+        return out
+    valid = np.flatnonzero(scan.valid)
+    pts = scan.points[valid]
+    gap = range_threshold(scan.ranges[valid], scan.resolution, k_segment, segment_floor_m)
+    runs = split_runs(np.zeros(len(valid), dtype=np.int8), pts, gap)
+    seg_of = np.empty(len(valid), dtype=np.int64)
+    for i, r in enumerate(runs):
+        seg_of[r.start:r.stop] = i
+    pred_sensor = pose.inverse().transform_points(predictions_world)
+    d = np.hypot(pts[None, :, 0] - pred_sensor[:, None, 0], pts[None, :, 1] - pred_sensor[:, None, 1])
+    for t in range(len(pred_sensor)):
+        near = np.unique(seg_of[d[t] <= radius_m])
+        if len(near) == 0:
+            continue
+        members = np.isin(seg_of, near)
+        p = pts[members]
+        if len(p) < min_points or np.hypot(*np.ptp(p, axis=0)) > max_size_m:
+            continue
+        out[t] = pose.transform_points(p.mean(axis=0, keepdims=True))[0]
+    return out

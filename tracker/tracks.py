@@ -1,0 +1,139 @@
+"""One track per person: a filterpy Kalman filter with a constant-velocity model in the
+world frame, and its lifecycle (tentative → confirmed → coasting → deleted)."""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+from filterpy.kalman import KalmanFilter
+
+from models.motion import H, constant_velocity_F, constant_velocity_Q
+
+
+@dataclass(frozen=True)
+class TrackParams:
+    """Tunables of the track filter and lifecycle (units in the names).
+
+    Attributes
+    ----------
+    accel_std_mps2 : float
+        White-noise acceleration of a walking person, m/s² (process noise).
+    init_speed_std_mps : float
+        Uncertainty of a new track's velocity, m/s.
+    confirm_hits, confirm_window : int
+        A tentative track is confirmed after ``confirm_hits`` updates within its last
+        ``confirm_window`` scans, and deleted when it can no longer reach that.
+    max_coast_s : float
+        A confirmed track with no update for this long is deleted.
+    max_static_s : float
+        A track kept only by static support (a paused person) for this long is deleted.
+    max_position_std_m : float
+        A track whose position uncertainty (1σ, largest axis) grows beyond this is deleted.
+    """
+
+    accel_std_mps2: float = 1.5
+    init_speed_std_mps: float = 1.0
+    confirm_hits: int = 3
+    confirm_window: int = 5
+    max_coast_s: float = 1.5
+    max_static_s: float = 10.0
+    max_position_std_m: float = 1.0
+
+
+@dataclass(frozen=True)
+class Track:
+    """A reported track at one scan (world frame, metres, m/s).
+
+    ``status`` is ``tentative``, ``confirmed`` or ``coasting`` (confirmed, not updated by
+    this scan); ``confidence`` in [0, 1]; ``target`` marks the followed person.
+    """
+
+    track_id: int
+    x: float
+    y: float
+    vx: float
+    vy: float
+    position_cov: tuple[tuple[float, float], tuple[float, float]]
+    status: str
+    confidence: float
+    age_s: float
+    target: bool = False
+
+
+class TrackState:
+    """The mutable state of one track (internal to the tracker)."""
+
+    def __init__(self, track_id: int, x: float, y: float, R: np.ndarray, stamp: float, params: TrackParams) -> None:
+        self.track_id = track_id
+        self.params = params
+        kf = KalmanFilter(dim_x=4, dim_z=2)
+        kf.x = np.array([x, 0.0, y, 0.0])
+        kf.P = np.diag([R[0, 0], params.init_speed_std_mps ** 2, R[1, 1], params.init_speed_std_mps ** 2])
+        kf.H = H.copy()
+        self.kf = kf
+        self.stamp = stamp  # time of the state, s
+        self.born = stamp
+        self.last_update = stamp
+        self.last_moving_update = stamp
+        self.hits: deque[bool] = deque([True], maxlen=params.confirm_window)
+        self.confirmed = params.confirm_hits <= 1
+        self.updated_now = True
+
+    @property
+    def position(self) -> np.ndarray:
+        return self.kf.x[[0, 2]]
+
+    @property
+    def position_cov(self) -> np.ndarray:
+        return self.kf.P[np.ix_([0, 2], [0, 2])]
+
+    def predict(self, stamp: float) -> None:
+        """Move the state to ``stamp`` (s) with the constant-velocity model."""
+        dt = stamp - self.stamp
+        if dt > 0:
+            # x = F x ;  P = F P Fᵀ + Q
+            self.kf.predict(F=constant_velocity_F(dt), Q=constant_velocity_Q(dt, self.params.accel_std_mps2 ** 2))
+            self.stamp = stamp
+        self.updated_now = False
+
+    def update(self, z: np.ndarray, R: np.ndarray, moving: bool) -> None:
+        """Correct with a candidate position ``z`` (m) of covariance ``R`` (m²)."""
+        # y = z - H x ; S = H P Hᵀ + R ; K = P Hᵀ S⁻¹ ; x = x + K y ; P = (I - K H) P
+        self.kf.update(z, R=R)
+        self.last_update = self.stamp
+        if moving:
+            self.last_moving_update = self.stamp
+        self.updated_now = True
+
+    def record(self, hit: bool) -> None:
+        """Book one scan's outcome; confirm when enough hits fall in the window."""
+        self.hits.append(hit)
+        if not self.confirmed and sum(self.hits) >= self.params.confirm_hits:
+            self.confirmed = True
+
+    def dead(self) -> bool:
+        """Whether the lifecycle rules delete this track now."""
+        p = self.params
+        if not self.confirmed:
+            # its first confirm_window scans did not bring confirm_hits updates
+            return len(self.hits) == p.confirm_window and sum(self.hits) < p.confirm_hits
+        if self.stamp - self.last_update > p.max_coast_s:
+            return True
+        if self.stamp - self.last_moving_update > p.max_static_s:
+            return True
+        return math.sqrt(float(np.linalg.eigvalsh(self.position_cov).max())) > p.max_position_std_m
+
+    def confidence(self) -> float:
+        """Share of recent scans with an update, faded by the time since the last one."""
+        share = sum(self.hits) / self.params.confirm_window
+        return float(min(1.0, share) * math.exp(-(self.stamp - self.last_update) / self.params.max_coast_s))
+
+    def report(self, target: bool = False) -> Track:
+        x, vx, y, vy = (float(v) for v in self.kf.x)
+        cov = self.position_cov
+        status = "tentative" if not self.confirmed else ("confirmed" if self.updated_now else "coasting")
+        return Track(self.track_id, x, y, vx, vy, ((float(cov[0, 0]), float(cov[0, 1])), (float(cov[1, 0]), float(cov[1, 1]))),
+                     status, self.confidence(), self.stamp - self.born, target)
