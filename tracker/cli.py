@@ -57,6 +57,8 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--topic", help="LaserScan topic (default: the only one)")
     run.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
     run.add_argument("--detections", metavar="FILE.csv", help="write the moving objects of every scan")
+    run.add_argument("--tracks", metavar="FILE.csv", help="write the confirmed people of every scan")
+    run.add_argument("--follow", metavar="auto|ID", help="follow a person: the closest ahead (auto) or a track id")
 
     ev = sub.add_parser("evaluate", help="score a tracks CSV against ground truth (CLEAR MOT, IDF1, OSPA)")
     ev.add_argument("tracks", metavar="TRACKS.csv", help="needs the columns scan_index,track_id,x,y")
@@ -99,16 +101,22 @@ def _print_v_min(params, resolution: float) -> None:
 def _cmd_run(args) -> int:
     import contextlib
 
-    from detection.detector import MovingObjectDetector
     from tracker.config import dump_config, load_config
-    from tracker.io import detections_csv
+    from tracker.io import outputs
     from tracker.io.atomic import atomic_output, check_writable
     from tracker.io.recording import Recording
+    from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
     from tracker.scan_checks import ScanChecker
 
     config = load_config(args.config)
-    if args.detections:
-        check_writable(args.detections)
+    follow = None
+    if args.follow is not None:
+        if args.follow != "auto" and not args.follow.isdigit():
+            raise InputError(f"--follow takes auto or a track id, got '{args.follow}'")
+        follow = args.follow if args.follow == "auto" else int(args.follow)
+    for out in (args.detections, args.tracks):
+        if out:
+            check_writable(out)
     log = logging.getLogger(PROG)
     t0 = time.perf_counter()
     if args.input is None:
@@ -118,15 +126,19 @@ def _cmd_run(args) -> int:
         source = SimulatedSource(DEFAULT_SCENE)
     else:
         source = Recording(args.input, args.topic, config.odometry)
-    outputs = contextlib.ExitStack()
-    with source as rec, outputs:
-        det_file = outputs.enter_context(atomic_output(args.detections)) if args.detections else None
+    stack = contextlib.ExitStack()
+    with source as rec, stack:
+        det_file = stack.enter_context(atomic_output(args.detections)) if args.detections else None
+        trk_file = stack.enter_context(atomic_output(args.tracks)) if args.tracks else None
         if det_file:
-            detections_csv.write_header(det_file)
-        detector = MovingObjectDetector(config.detector.params())
-        _print_v_min(detector.params, rec.resolution)
+            outputs.write_header(det_file)
+        if trk_file:
+            outputs.write_tracks_header(trk_file)
+        tracker = PeopleTracker.from_config(config, follow)
+        _print_v_min(tracker.detector.params, rec.resolution)
         checker = ScanChecker(config.scan_checks.stamp_jump_periods, config.scan_checks.beam_count_confirm)
-        used = skipped = restarts = with_pose = n_objects = 0
+        used = skipped = restarts = with_pose = n_objects = n_track_rows = 0
+        people_ids: set[int] = set()
         first_stamp = last_stamp = None
         path_m = 0.0
         last_pose = None
@@ -143,11 +155,17 @@ def _cmd_run(args) -> int:
                 restarts += verdict.restart
                 scan = record.scan
                 if verdict.restart:
-                    detector.reset()
-                found = detector.detect(scan, record.pose)
+                    tracker.reset()
+                tracks = tracker.step(scan, record.pose)
+                found = tracker.last.detection
                 n_objects += len(found.objects)
+                n_track_rows += len(tracks)
+                people_ids.update(t.track_id for t in tracks)
                 if det_file:
-                    detections_csv.write_rows(det_file, record.index, scan.stamp, found.objects)
+                    outputs.write_rows(det_file, record.index, scan.stamp, found.objects)
+                if trk_file:
+                    outputs.write_track_rows(trk_file, record.index, scan.stamp, tracks,
+                                             tracks_in_sensor_frame(tracks, tracker.last.pose))
                 first_stamp = scan.stamp if first_stamp is None else first_stamp
                 last_stamp = scan.stamp
                 if record.pose is not None:
@@ -169,9 +187,15 @@ def _cmd_run(args) -> int:
               f"{span:.1f} s of recording in {elapsed:.2f} s ({total / max(elapsed, 1e-9):.0f} scans/s)")
         print(f"moving objects: {n_objects} ({n_objects / max(used, 1):.2f} per scan)"
               + (f" written to {args.detections}" if args.detections else ""))
-        if args.detections:
-            with atomic_output(f"{args.detections}.config.yaml") as fh:
-                fh.write(dump_config(config))
+        print(f"people: {len(people_ids)} confirmed tracks, {n_track_rows / max(used, 1):.2f} per scan"
+              + (f" written to {args.tracks}" if args.tracks else ""))
+        if tracker.selector is not None:
+            events = tracker.selector.events
+            print(f"following: {', '.join(events) if events else 'no target found'}")
+        for out in (args.detections, args.tracks):
+            if out:
+                with atomic_output(f"{out}.config.yaml") as fh:
+                    fh.write(dump_config(config))
     return 0
 
 

@@ -97,6 +97,8 @@ class TracksConfig:
     max_coast_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3600.0))
     max_static_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=86400.0))
     max_position_std_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
+    confirm_min_travel_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
+    max_tentative_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3600.0))
 
     def params(self):
         from tracker.tracks import TrackParams
@@ -113,6 +115,7 @@ class AssociationConfig:
     support_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
     support_sigma_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     support_min_points: int = field(metadata=_spec(lo=1, hi=10000))
+    support_anchor_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
 
     def params(self):
         from tracker.people_tracker import AssociationParams

@@ -37,6 +37,10 @@ class AssociationParams:
     support_radius_m, support_sigma_m, support_min_points : float, float, int
         Static support: how near the prediction readings must be (m), the standard
         deviation of the position they give (m), and how many are needed.
+    support_anchor_m : float
+        Static support must also lie this close to where the track's last moving
+        candidate put it (m): a standing leg or a pausing person stays where their legs
+        were last seen moving, so a coasting track cannot slide from clutter to clutter.
     """
 
     method: str = "gnn"
@@ -45,6 +49,7 @@ class AssociationParams:
     support_radius_m: float = 0.35
     support_sigma_m: float = 0.12
     support_min_points: int = 3
+    support_anchor_m: float = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -151,8 +156,9 @@ class PeopleTracker:
                                self.assoc.support_min_points)
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
         for i, z in zip(idle, found):
-            if z is not None:
-                self._tracks[i].update(z, R, moving=False)
+            t = self._tracks[i]
+            if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
+                t.update(z, R, moving=False)
 
     def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float) -> None:
         known = np.array([t.position for t in self._tracks]).reshape(-1, 2)

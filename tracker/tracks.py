@@ -32,6 +32,11 @@ class TrackParams:
         A track kept only by static support (a paused person) for this long is deleted.
     max_position_std_m : float
         A track whose position uncertainty (1σ, largest axis) grows beyond this is deleted.
+    confirm_min_travel_m : float
+        A tentative track is confirmed only once it is this far from where it started:
+        people walk, clutter that the detector flags now and then does not.
+    max_tentative_s : float
+        A track still tentative after this long is deleted.
     """
 
     accel_std_mps2: float = 1.5
@@ -41,6 +46,8 @@ class TrackParams:
     max_coast_s: float = 1.5
     max_static_s: float = 10.0
     max_position_std_m: float = 1.0
+    confirm_min_travel_m: float = 0.4
+    max_tentative_s: float = 2.0
 
 
 @dataclass(frozen=True)
@@ -78,8 +85,10 @@ class TrackState:
         self.born = stamp
         self.last_update = stamp
         self.last_moving_update = stamp
+        self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
         self.hits: deque[bool] = deque([True], maxlen=params.confirm_window)
-        self.confirmed = params.confirm_hits <= 1
+        self.origin = np.array([x, y])
+        self.confirmed = params.confirm_hits <= 1 and params.confirm_min_travel_m <= 0
         self.updated_now = True
 
     @property
@@ -106,20 +115,23 @@ class TrackState:
         self.last_update = self.stamp
         if moving:
             self.last_moving_update = self.stamp
+            self.moving_position = self.position.copy()
         self.updated_now = True
 
     def record(self, hit: bool) -> None:
         """Book one scan's outcome; confirm when enough hits fall in the window."""
         self.hits.append(hit)
-        if not self.confirmed and sum(self.hits) >= self.params.confirm_hits:
+        if (not self.confirmed and sum(self.hits) >= self.params.confirm_hits
+                and np.hypot(*(self.position - self.origin)) >= self.params.confirm_min_travel_m):
             self.confirmed = True
 
     def dead(self) -> bool:
         """Whether the lifecycle rules delete this track now."""
         p = self.params
         if not self.confirmed:
-            # its first confirm_window scans did not bring confirm_hits updates
-            return len(self.hits) == p.confirm_window and sum(self.hits) < p.confirm_hits
+            # too few updates in its window, or it has not gone anywhere in time
+            return (len(self.hits) == p.confirm_window and sum(self.hits) < p.confirm_hits) or \
+                self.stamp - self.born > p.max_tentative_s
         if self.stamp - self.last_update > p.max_coast_s:
             return True
         if self.stamp - self.last_moving_update > p.max_static_s:

@@ -10,8 +10,7 @@ import numpy as np
 from tracker.errors import InputError
 from tracker.evaluation import TrackRows
 
-TRACK_COLUMNS = ("scan_index", "stamp", "track_id", "x", "y", "world_x", "world_y", "world_vx", "world_vy",
-                 "confidence", "target")
+from tracker.io.outputs import TRACK_COLUMNS  # noqa: F401  (the full contract, for readers of this module)
 NEEDED = ("scan_index", "track_id", "x", "y")
 
 
