@@ -71,6 +71,7 @@ class SimStep:
     odom_pose: Pose2D
     odometry: list[OdometrySample]
     truth: Truth
+    odom_pose_last_beam: Pose2D | None = None  # odometry base pose when the last beam fired
 
 
 def visible_people(scan: Scan, beam_person: np.ndarray) -> set[int]:
@@ -181,25 +182,34 @@ class Simulation:
                       np.array([i in seen for i in ids], dtype=bool), beam_person)
         odom_pose = self._odometer.pose
         odometry = [self.odometry_now()] if self.index == 0 else []
-        odometry += self._advance(cmd, command is not None)
+        odometry += self._advance(cmd, command is not None, sweep)
         self.index += 1
-        return SimStep(scan, odom_pose, odometry, truth)
+        return SimStep(scan, odom_pose, odometry, truth, self._odom_sweep_end)
 
-    def _advance(self, cmd: Command, external: bool) -> list[OdometrySample]:
-        """Move the robot through one scan period; odometry samples on the way."""
+    def _advance(self, cmd: Command, external: bool, sweep: float = 0.0) -> list[OdometrySample]:
+        """Move the robot through one scan period; odometry samples on the way.
+
+        Also notes the odometry pose at ``sweep`` seconds into the period (the last beam).
+        """
         dt = 1.0 / self.physics_hz
         period = self.laser.period
         t = self.time
         end = t + period
+        sweep_end = t + sweep
+        self._odom_sweep_end = self._odometer.pose
         samples = []
         while t < end - 1e-12:
             h = min(dt, end - t)
+            if t < sweep_end < t + h:
+                h = sweep_end - t  # land exactly on the last beam's time
             if not external and self.driver is not None:
                 cmd = self.driver(t, self.robot)
             new = integrate(self.robot, cmd, h)
             odom_pose = self._odometer.update(t, self.robot, new)
             self.robot = new
             t += h
+            if abs(t - sweep_end) < 1e-9:
+                self._odom_sweep_end = odom_pose
             if t >= self._next_odom - 1e-9:
                 samples.append(OdometrySample(self.t0 + t, odom_pose, cmd.v, cmd.omega))
                 self._next_odom += 1.0 / self.odom_rate_hz

@@ -156,7 +156,7 @@ def _cmd_run(args) -> int:
                 scan = record.scan
                 if verdict.restart:
                     tracker.reset()
-                tracks = tracker.step(scan, record.pose)
+                tracks = tracker.step(scan, record.pose, record.pose_last_beam)
                 found = tracker.last.detection
                 n_objects += len(found.objects)
                 n_track_rows += len(tracks)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from detection.deskew import deskew
 from detection.detector import Detection, DetectorParams, MovingObjectDetector
 from models.pose import Pose2D
 from models.scan import Scan
@@ -60,6 +61,7 @@ class StepResult:
     detection: Detection
     candidates: list[PersonCandidate]
     pose: Pose2D
+    scan: Scan  # as the detector saw it (de-skewed when the sweep's poses were known)
 
 
 class PeopleTracker:
@@ -94,17 +96,21 @@ class PeopleTracker:
         """Forget the scan history (a stamp jump, a new scanner); tracks coast on."""
         self.detector.reset()
 
-    def step(self, scan: Scan, pose: Pose2D | None = None) -> list[Track]:
+    def step(self, scan: Scan, pose: Pose2D | None = None, pose_last_beam: Pose2D | None = None) -> list[Track]:
         """Process one scan; return the confirmed tracks (coasting ones included).
 
         Parameters
         ----------
         scan : Scan
         pose : Pose2D, optional
-            Sensor pose in the world (fixed) frame at the scan stamp; without one the
-            sensor frame is the world frame.
+            Sensor pose in the world (fixed) frame at the scan stamp (its first beam);
+            without one the sensor frame is the world frame.
+        pose_last_beam : Pose2D, optional
+            Sensor pose when the last beam fired; with it the scan is de-skewed first.
         """
         world = pose or Pose2D()
+        if pose is not None and pose_last_beam is not None:
+            scan = deskew(scan, pose, pose_last_beam)  # 0. every beam from the first beam's pose
         detection = self.detector.detect(scan, pose)  # 1. moving objects (sensor frame)
         candidates = self._candidates(detection, world)  # 2. legs paired into people (world frame)
         for t in self._tracks:  # 3. predict every track to the scan time
@@ -120,7 +126,7 @@ class PeopleTracker:
         self._delete(scan.stamp)  # 8. delete what the lifecycle rules end
         target = self._follow(world, scan.stamp)  # 9. the followed person
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.confirmed]
-        self.last = StepResult(reported, detection, candidates, world)
+        self.last = StepResult(reported, detection, candidates, world, scan)
         return reported
 
     def _candidates(self, detection: Detection, world: Pose2D) -> list[PersonCandidate]:

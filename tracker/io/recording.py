@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Iterator
 
 from models.pose import Pose2D
+from detection.deskew import sweep_duration
 from models.scan import Scan
 from tracker.config import OdometryConfig
 from tracker.errors import InputError
@@ -42,6 +43,9 @@ class ScanRecord:
         recording has no odometry or none covers this stamp.
     problem : str or None
         Why ``scan`` is None.
+    pose_last_beam : Pose2D or None
+        The sensor pose when the scan's last beam fired (``stamp`` + the sweep), for
+        de-skew; None without odometry or without ``time_increment``.
     """
 
     index: int
@@ -49,6 +53,7 @@ class ScanRecord:
     scan: Scan | None
     pose: Pose2D | None
     problem: str | None = None
+    pose_last_beam: Pose2D | None = None
 
 
 def scan_from_msg(msg) -> Scan:
@@ -159,8 +164,10 @@ class Recording:
             if rec.scan is None:
                 return rec
             pose = source.pose_at(rec.scan.stamp)
+            sweep = sweep_duration(rec.scan)
+            pose_last = source.pose_at(rec.scan.stamp + sweep) if pose is not None and sweep > 0 else None
             source.prune(rec.scan.stamp - _PRUNE_MARGIN_S)  # later scans are stamped later
-            return ScanRecord(rec.index, rec.bag_time, rec.scan, pose, rec.problem)
+            return ScanRecord(rec.index, rec.bag_time, rec.scan, pose, rec.problem, pose_last)
 
         messages = self._reader.messages(connections=self._scan_conns + list(source.connections))
         while True:
@@ -177,7 +184,8 @@ class Recording:
                 index += 1
             else:
                 source.feed(conn, raw)
-            while pending and (pending[0].scan is None or source.ready(pending[0].scan.stamp)
+            while pending and (pending[0].scan is None
+                               or source.ready(pending[0].scan.stamp + sweep_duration(pending[0].scan))
                                or bag_time - pending[0].bag_time > wait_ns):
                 yield release(pending.popleft())
         while pending:

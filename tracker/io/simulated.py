@@ -57,7 +57,8 @@ class SimulatedSource:
             step = self.sim.step()
             self.truths.append(step.truth)
             bag_time = int(round(step.scan.stamp * 1e9))
-            yield ScanRecord(index, bag_time, step.scan, step.odom_pose @ self.sim.mount)
+            last = step.odom_pose_last_beam @ self.sim.mount if step.odom_pose_last_beam is not None else None
+            yield ScanRecord(index, bag_time, step.scan, step.odom_pose @ self.sim.mount, None, last)
 
 
 def simulate_to_bag(scenario: str, output: str | Path, seed: int | None = None, people: int | None = None,
