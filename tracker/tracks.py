@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
-from models.motion import H, constant_velocity_F, constant_velocity_Q
+from models.motion import H, constant_velocity_FQ
 
 
 @dataclass(frozen=True)
@@ -93,18 +93,21 @@ class TrackState:
 
     @property
     def position(self) -> np.ndarray:
-        return self.kf.x[[0, 2]]
+        """Estimated position (x, y), world frame, metres."""
+        return self.kf.x[::2]  # state order [x, vx, y, vy]
 
     @property
     def position_cov(self) -> np.ndarray:
-        return self.kf.P[np.ix_([0, 2], [0, 2])]
+        """Its 2x2 covariance, m²."""
+        return self.kf.P[::2, ::2]
 
     def predict(self, stamp: float) -> None:
         """Move the state to ``stamp`` (s) with the constant-velocity model."""
         dt = stamp - self.stamp
         if dt > 0:
+            F, Q = constant_velocity_FQ(dt, self.params.accel_std_mps2 ** 2)
             # x = F x ;  P = F P Fᵀ + Q
-            self.kf.predict(F=constant_velocity_F(dt), Q=constant_velocity_Q(dt, self.params.accel_std_mps2 ** 2))
+            self.kf.predict(F=F, Q=Q)
             self.stamp = stamp
         self.updated_now = False
 
