@@ -86,9 +86,9 @@ class LaserModel:
         ----------
         stamp : float
             Time of beam 0, seconds.
-        sensor_poses : Pose2D or sequence of Pose2D
+        sensor_poses : Pose2D, sequence of Pose2D, or ndarray of shape (n, 3)
             Sensor pose in the world frame; one pose, or one for each beam (a moving sensor
-            fires each beam from where it is at that instant).
+            fires each beam from where it is at that instant), as Pose2D or rows x, y, yaw.
         segments, circles : ndarray
             The scene in the world frame (see :func:`models.raycast.cast_rays`).
         rng : numpy.random.Generator, optional
@@ -108,7 +108,8 @@ class LaserModel:
             ys = np.full(n, sensor_poses.y)
             yaws = np.full(n, sensor_poses.yaw)
         else:
-            arr = np.array([(p.x, p.y, p.yaw) for p in sensor_poses], dtype=float)
+            arr = sensor_poses if isinstance(sensor_poses, np.ndarray) else \
+                np.array([(p.x, p.y, p.yaw) for p in sensor_poses], dtype=float)
             xs, ys, yaws = arr[:, 0], arr[:, 1], arr[:, 2]
         heading = yaws + angles
         origins = np.column_stack([xs, ys])

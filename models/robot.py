@@ -30,6 +30,21 @@ def integrate(pose: Pose2D, cmd: Command, dt: float) -> Pose2D:
                   float(wrap_angle(th1)))
 
 
+def integrate_many(pose: Pose2D, cmd: Command, dts: np.ndarray) -> np.ndarray:
+    """Exact unicycle poses after each of ``dts`` seconds at constant ``cmd``: (k, 3) x, y, yaw."""
+    th = pose.yaw
+    dts = np.asarray(dts, dtype=float)
+    th1 = th + cmd.omega * dts
+    if abs(cmd.omega) < 1e-9:
+        xs = pose.x + cmd.v * dts * math.cos(th)
+        ys = pose.y + cmd.v * dts * math.sin(th)
+    else:
+        r = cmd.v / cmd.omega
+        xs = pose.x + r * (np.sin(th1) - math.sin(th))
+        ys = pose.y - r * (np.cos(th1) - math.cos(th))
+    return np.column_stack([xs, ys, th1])
+
+
 class ScriptedDriver:
     """Commands from a script of ``(duration_s, v, omega)`` pieces, then stop."""
 

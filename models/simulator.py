@@ -16,7 +16,7 @@ import numpy as np
 from models.laser import LaserModel
 from models.person import Walker
 from models.pose import Pose2D
-from models.robot import Command, Odometer, integrate
+from models.robot import Command, Odometer, integrate, integrate_many
 from models.scan import Scan
 from models.world import World
 
@@ -158,11 +158,12 @@ class Simulation:
         cmd = command if command is not None else (self.driver(t, self.robot) if self.driver else Command())
         moving = abs(cmd.v) > 0 or abs(cmd.omega) > 0
         if moving and sweep > 0:
-            n_sub = 16
-            sub_t = np.linspace(0.0, sweep, n_sub)
-            sub_poses = [integrate(self.robot, cmd, dt) @ self.mount for dt in sub_t]
-            which = np.minimum((np.arange(laser.n_beams) * laser.time_increment / sweep * (n_sub - 1) + 0.5).astype(int), n_sub - 1)
-            beam_poses = [sub_poses[k] for k in which]
+            # each beam fires from where the sensor is at its own time (base pose ∘ mount)
+            base = integrate_many(self.robot, cmd, np.arange(laser.n_beams) * laser.time_increment)
+            c, s_ = np.cos(base[:, 2]), np.sin(base[:, 2])
+            m = self.mount
+            beam_poses = np.column_stack([base[:, 0] + c * m.x - s_ * m.y, base[:, 1] + s_ * m.x + c * m.y,
+                                          base[:, 2] + m.yaw])
         else:
             beam_poses = self.robot @ self.mount
         circles, owner = self._people_circles(t)

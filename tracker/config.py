@@ -123,6 +123,31 @@ class AssociationConfig:
 
 
 @dataclass(frozen=True)
+class AlignmentConfig:
+    """Scan matching; see :class:`detection.align.AlignParams` and :class:`detection.icp.IcpParams`."""
+
+    enabled: bool = field(metadata=_spec())
+    exclude_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
+    max_iterations: int = field(metadata=_spec(lo=1, hi=1000))
+    max_correspondence_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    min_correspondence_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    trim_fraction: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1.0))
+    normal_max_gap_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    degeneracy_ratio: float = field(metadata=_spec(lo=0.0, hi=1.0))
+    min_pairs: int = field(metadata=_spec(lo=3, hi=100000))
+    min_overlap: float = field(metadata=_spec(lo=0.0, hi=1.0))
+    max_rms_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    max_correction_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
+    max_correction_rad: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3.15))
+
+    def params(self):
+        from detection.align import AlignParams
+        from detection.icp import IcpParams
+        icp = {k: v for k, v in dataclasses.asdict(self).items() if k not in ("enabled", "exclude_radius_m")}
+        return AlignParams(self.enabled, self.exclude_radius_m, IcpParams(**icp))
+
+
+@dataclass(frozen=True)
 class Config:
     """The whole resolved configuration."""
 
@@ -132,6 +157,7 @@ class Config:
     pairing: PairingConfig
     tracks: TracksConfig
     association: AssociationConfig
+    alignment: AlignmentConfig
 
     def to_dict(self) -> dict:
         def plain(v):

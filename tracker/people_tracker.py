@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from detection.deskew import deskew
+from detection.align import Alignment, AlignParams, ScanAligner
 from detection.detector import Detection, DetectorParams, MovingObjectDetector
 from models.pose import Pose2D
 from models.scan import Scan
@@ -61,7 +61,8 @@ class StepResult:
     detection: Detection
     candidates: list[PersonCandidate]
     pose: Pose2D
-    scan: Scan  # as the detector saw it (de-skewed when the sweep's poses were known)
+    scan: Scan  # as the detector saw it (de-skewed)
+    alignment: Alignment
 
 
 class PeopleTracker:
@@ -76,7 +77,8 @@ class PeopleTracker:
 
     def __init__(self, detector: DetectorParams | None = None, pairing: PairingParams | None = None,
                  tracks: TrackParams | None = None, association: AssociationParams | None = None,
-                 follow: str | int | None = None) -> None:
+                 follow: str | int | None = None, alignment: AlignParams | None = None) -> None:
+        self.aligner = ScanAligner(alignment or AlignParams())
         self.detector = MovingObjectDetector(detector or DetectorParams())
         self.pairing = pairing or PairingParams()
         self.track_params = tracks or TrackParams()
@@ -90,11 +92,12 @@ class PeopleTracker:
     def from_config(cls, config, follow: str | int | None = None) -> "PeopleTracker":
         """A tracker from a resolved :class:`tracker.config.Config`."""
         return cls(config.detector.params(), config.pairing.params(), config.tracks.params(),
-                   config.association.params(), follow)
+                   config.association.params(), follow, config.alignment.params())
 
     def reset(self) -> None:
         """Forget the scan history (a stamp jump, a new scanner); tracks coast on."""
         self.detector.reset()
+        self.aligner.reset()
 
     def step(self, scan: Scan, pose: Pose2D | None = None, pose_last_beam: Pose2D | None = None) -> list[Track]:
         """Process one scan; return the confirmed tracks (coasting ones included).
@@ -103,15 +106,16 @@ class PeopleTracker:
         ----------
         scan : Scan
         pose : Pose2D, optional
-            Sensor pose in the world (fixed) frame at the scan stamp (its first beam);
-            without one the sensor frame is the world frame.
+            Sensor pose from odometry in its fixed frame at the scan stamp (its first beam).
+            Scan matching refines it (or, without it, finds the motion on its own); the
+            world frame is this fixed frame, or the first scan's sensor frame.
         pose_last_beam : Pose2D, optional
-            Sensor pose when the last beam fired; with it the scan is de-skewed first.
+            Sensor pose from odometry when the last beam fired, for de-skew.
         """
-        world = pose or Pose2D()
-        if pose is not None and pose_last_beam is not None:
-            scan = deskew(scan, pose, pose_last_beam)  # 0. every beam from the first beam's pose
-        detection = self.detector.detect(scan, pose)  # 1. moving objects (sensor frame)
+        people = np.array([t.position for t in self._tracks if t.confirmed]).reshape(-1, 2)
+        aligned = self.aligner.align(scan, pose, pose_last_beam, people)  # 0. de-skew and align
+        scan, world = aligned.scan, aligned.pose
+        detection = self.detector.detect(scan, world)  # 1. moving objects (sensor frame)
         candidates = self._candidates(detection, world)  # 2. legs paired into people (world frame)
         for t in self._tracks:  # 3. predict every track to the scan time
             t.predict(scan.stamp)
@@ -126,7 +130,7 @@ class PeopleTracker:
         self._delete(scan.stamp)  # 8. delete what the lifecycle rules end
         target = self._follow(world, scan.stamp)  # 9. the followed person
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.confirmed]
-        self.last = StepResult(reported, detection, candidates, world, scan)
+        self.last = StepResult(reported, detection, candidates, world, scan, aligned)
         return reported
 
     def _candidates(self, detection: Detection, world: Pose2D) -> list[PersonCandidate]:

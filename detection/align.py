@@ -1,0 +1,132 @@
+"""Alignment of each scan with the previous one: the sensor pose in the world frame.
+
+:class:`ScanAligner` chains scan-to-scan matches. Its prior for each match is the
+odometry's relative motion when the recording has odometry, and otherwise a
+constant-velocity prediction from the last matched motion. The scan is de-skewed first
+(the odometry's motion over the sweep, or the predicted one). Readings near people the
+tracker follows are left out of matching (they move). When matching fails the prior is
+kept, and the result says so.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from detection.deskew import deskew, sweep_duration
+from detection.icp import IcpParams, MatchResult, ReferenceScan, match
+from models.pose import Pose2D, interpolate_pose
+from models.scan import Scan
+
+
+@dataclass(frozen=True)
+class AlignParams:
+    """Attributes
+    ----------
+    enabled : bool
+        Match scans (otherwise the odometry pose, or none, is used as it is).
+    exclude_radius_m : float
+        Readings this close to a tracked person are left out of matching.
+    icp : IcpParams
+    """
+
+    enabled: bool = True
+    exclude_radius_m: float = 0.5
+    icp: IcpParams = IcpParams()
+
+
+@dataclass(frozen=True, eq=False)
+class Alignment:
+    """One scan's alignment.
+
+    Attributes
+    ----------
+    scan : Scan
+        The scan de-skewed to its first beam's pose.
+    pose : Pose2D
+        Sensor pose (first beam) in the world frame: the odometry frame corrected by scan
+        matching, or the first scan's pose when there is no odometry.
+    match : MatchResult or None
+        The scan-to-scan match (None for the first scan or with matching disabled).
+    prior : str
+        ``odometry`` or ``prediction``.
+    """
+
+    scan: Scan
+    pose: Pose2D
+    match: MatchResult | None
+    prior: str
+
+
+def _scale_motion(motion: Pose2D, fraction: float) -> Pose2D:
+    return interpolate_pose(Pose2D(), motion, fraction)
+
+
+class ScanAligner:
+    """Keeps the previous scan and pose and aligns each new scan to it."""
+
+    def __init__(self, params: AlignParams | None = None) -> None:
+        self.params = params or AlignParams()
+        self.reset()
+
+    def reset(self) -> None:
+        """Start afresh (after a stamp jump); the world pose continues from where it was."""
+        self._ref: ReferenceScan | None = None
+        self._prev_stamp: float | None = None
+        self._prev_odom: Pose2D | None = None
+        self._velocity: tuple[Pose2D, float] | None = None  # last matched motion and its duration
+        self._world = getattr(self, "_world", Pose2D())
+
+    def align(self, scan: Scan, odom: Pose2D | None = None, odom_last_beam: Pose2D | None = None,
+              people_world: np.ndarray | None = None) -> Alignment:
+        """Align ``scan``.
+
+        Parameters
+        ----------
+        scan : Scan
+        odom, odom_last_beam : Pose2D, optional
+            Sensor pose from odometry at the first and the last beam.
+        people_world : ndarray, shape (k, 2), optional
+            Where tracked people are expected now, world frame, metres.
+        """
+        p = self.params
+        dt = None if self._prev_stamp is None else scan.stamp - self._prev_stamp
+        # the prior: odometry's relative motion, or the last motion scaled to this interval
+        if odom is not None and self._prev_odom is not None:
+            prior, kind = self._prev_odom.between(odom), "odometry"
+        elif self._velocity is not None and dt is not None and dt > 0:
+            motion, span = self._velocity
+            prior, kind = _scale_motion(motion, dt / span), "prediction"
+        else:
+            prior, kind = Pose2D(), "odometry" if odom is not None else "prediction"
+        # de-skew: the sweep's motion from odometry, or predicted
+        sweep = sweep_duration(scan)
+        if odom is not None and odom_last_beam is not None:
+            scan = deskew(scan, odom, odom_last_beam)
+        elif self._velocity is not None and sweep > 0:
+            motion, span = self._velocity
+            scan = deskew(scan, Pose2D(), _scale_motion(motion, sweep / span))
+        result = None
+        rel = prior
+        points = scan.valid_points
+        if p.enabled and self._ref is not None:
+            exclude = None
+            if people_world is not None and len(people_world):
+                guess = self._world @ prior
+                local = guess.inverse().transform_points(np.asarray(people_world, dtype=float))
+                d = np.hypot(points[:, None, 0] - local[None, :, 0], points[:, None, 1] - local[None, :, 1])
+                exclude = d.min(axis=1) < p.exclude_radius_m
+            result = match(points, self._ref, prior, p.icp, exclude)
+            rel = result.pose
+        if self._prev_stamp is None:
+            self._world = odom if odom is not None else Pose2D()
+        elif p.enabled or odom is None:
+            self._world = self._world @ rel
+        else:
+            self._world = odom
+        if dt is not None and dt > 0 and (result is None or result.ok or kind == "odometry"):
+            self._velocity = (rel, dt)
+        self._ref = ReferenceScan(points, p.icp) if p.enabled else None
+        self._prev_stamp, self._prev_odom = scan.stamp, odom
+        return Alignment(scan, self._world, result, kind)
