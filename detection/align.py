@@ -78,6 +78,14 @@ class ScanAligner:
         self._velocity: tuple[Pose2D, float] | None = None  # last matched motion and its duration
         self._world = getattr(self, "_world", Pose2D())
 
+    def _exclusion(self, points: np.ndarray, rel: Pose2D, people_world: np.ndarray | None) -> np.ndarray | None:
+        """Readings near the people, whose world positions are placed with the guess ``rel``."""
+        if people_world is None or not len(people_world) or not len(points):
+            return None
+        local = (self._world @ rel).inverse().transform_points(np.asarray(people_world, dtype=float))
+        d = np.hypot(points[:, None, 0] - local[None, :, 0], points[:, None, 1] - local[None, :, 1])
+        return d.min(axis=1) < self.params.exclude_radius_m
+
     def align(self, scan: Scan, odom: Pose2D | None = None, odom_last_beam: Pose2D | None = None,
               people_world: np.ndarray | None = None) -> Alignment:
         """Align ``scan``.
@@ -101,24 +109,30 @@ class ScanAligner:
         else:
             prior, kind = Pose2D(), "odometry" if odom is not None else "prediction"
         # de-skew: the sweep's motion from odometry, or predicted
+        raw = scan
         sweep = sweep_duration(scan)
-        if odom is not None and odom_last_beam is not None:
-            scan = deskew(scan, odom, odom_last_beam)
+        with_odometry = odom is not None and odom_last_beam is not None
+        if with_odometry:
+            scan = deskew(raw, odom, odom_last_beam)
         elif self._velocity is not None and sweep > 0:
             motion, span = self._velocity
-            scan = deskew(scan, Pose2D(), _scale_motion(motion, sweep / span))
+            scan = deskew(raw, Pose2D(), _scale_motion(motion, sweep / span))
         result = None
         rel = prior
         points = scan.valid_points
         if p.enabled and self._ref is not None:
-            exclude = None
-            if people_world is not None and len(people_world):
-                guess = self._world @ prior
-                local = guess.inverse().transform_points(np.asarray(people_world, dtype=float))
-                d = np.hypot(points[:, None, 0] - local[None, :, 0], points[:, None, 1] - local[None, :, 1])
-                exclude = d.min(axis=1) < p.exclude_radius_m
-            result = match(points, self._ref, prior, p.icp, exclude)
+            result = match(points, self._ref, prior, p.icp, self._exclusion(points, prior, people_world))
             rel = result.pose
+            # without odometry a wrong prediction also skewed the scan: de-skew with the
+            # matched motion and match once more when the two disagree
+            miss = prior.between(rel)
+            if (not with_odometry and result.ok and sweep > 0 and dt
+                    and (abs(miss.yaw) > 0.005 or np.hypot(miss.x, miss.y) > 0.01)):
+                scan = deskew(raw, Pose2D(), _scale_motion(rel, sweep / dt))
+                points = scan.valid_points
+                again = match(points, self._ref, rel, p.icp, self._exclusion(points, rel, people_world))
+                if again.ok:
+                    result, rel = again, again.pose
         if self._prev_stamp is None:
             self._world = odom if odom is not None else Pose2D()
         elif p.enabled or odom is None:

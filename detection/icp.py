@@ -49,7 +49,7 @@ class IcpParams:
     min_correspondence_m: float = 0.1
     trim_fraction: float = 0.8
     normal_max_gap_m: float = 0.2
-    degeneracy_ratio: float = 0.02
+    degeneracy_ratio: float = 0.06
     min_pairs: int = 30
     min_overlap: float = 0.3
     max_rms_m: float = 0.05
@@ -90,9 +90,10 @@ class MatchResult:
     reason: str | None = None
 
 
-def line_normals(points: np.ndarray, max_gap: float) -> np.ndarray:
-    """Unit normals of readings in scan order, from their two neighbours; nan where the
-    neighbours are missing or farther than ``max_gap`` (edges, depth jumps).
+def line_normals(points: np.ndarray, max_gap: float, half_width: int = 2) -> np.ndarray:
+    """Unit normals of readings in scan order, from the neighbours ``half_width`` places
+    either side (a wider baseline averages the range noise out); nan where a gap between
+    consecutive readings on that span exceeds ``max_gap`` (edges, depth jumps).
 
     Parameters
     ----------
@@ -100,17 +101,19 @@ def line_normals(points: np.ndarray, max_gap: float) -> np.ndarray:
         Valid readings in beam order, metres.
     """
     n = len(points)
+    k = half_width
     normals = np.full((n, 2), np.nan)
-    if n < 3:
+    if n < 2 * k + 1:
         return normals
-    prev_, next_ = points[:-2], points[2:]
-    mid = points[1:-1]
-    ok = (np.hypot(*(mid - prev_).T) < max_gap) & (np.hypot(*(next_ - mid).T) < max_gap)
-    tangent = next_ - prev_
+    step_ok = np.hypot(*np.diff(points, axis=0).T) < max_gap  # (n-1,)
+    # every step on the span i-k .. i+k must be short: a sliding window over the steps
+    bad = np.concatenate([[0], np.cumsum(~step_ok)])
+    span_bad = bad[2 * k:] - bad[: n - 2 * k]  # steps i-k..i+k-1 for i = k .. n-k-1
+    tangent = points[2 * k:] - points[: n - 2 * k]
     length = np.hypot(tangent[:, 0], tangent[:, 1])
-    ok &= length > 1e-9
+    ok = (span_bad == 0) & (length > 1e-9)
     nrm = np.column_stack([-tangent[:, 1], tangent[:, 0]]) / np.where(length > 0, length, 1.0)[:, None]
-    normals[1:-1][ok] = nrm[ok]
+    normals[k: n - k][ok] = nrm[ok]
     return normals
 
 
