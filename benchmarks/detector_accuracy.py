@@ -8,7 +8,8 @@ For every scan of the annotated recording: the share of ground-truth people with
 detected moving object within 0.3 m and within 0.5 m (hull centroids, sensor frame), and
 the number of detections per scan farther than ``--far`` metres from every annotated
 person. On a recording without annotations (``negative_2.bag``: nobody is there) every
-detection counts as far.
+detection counts as far. Scans are prepared as the pipeline does (de-skew, then scan
+matching unless ``--no-matching``; odometry where the recording has it).
 """
 
 from __future__ import annotations
@@ -19,6 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
+from dataclasses import replace
+
+from detection.align import ScanAligner
 from detection.detector import MovingObjectDetector
 from tracker.config import load_config
 from tracker.errors import InputError
@@ -29,7 +33,8 @@ from tracker.scan_checks import ScanChecker
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh"
 
 
-def detector_figures(bag: Path, topic: str | None, config, far: float, annotated: bool) -> dict:
+def detector_figures(bag: Path, topic: str | None, config, far: float, annotated: bool,
+                     matching: bool = True) -> dict:
     gt = read_bag_ground_truth(bag, topic) if annotated else None
     gt_by_scan: dict[int, np.ndarray] = {}
     if gt is not None:
@@ -37,6 +42,7 @@ def detector_figures(bag: Path, topic: str | None, config, far: float, annotated
             sel = gt.scan_index == k
             gt_by_scan[int(k)] = np.column_stack([gt.x[sel], gt.y[sel]])
     det = MovingObjectDetector(config.detector.params())
+    aligner = ScanAligner(replace(config.alignment.params(), enabled=matching))
     checker = ScanChecker(config.scan_checks.stamp_jump_periods, config.scan_checks.beam_count_confirm)
     near3 = near5 = n_gt = n_det = n_far = scans = 0
     with Recording(bag, topic, config.odometry) as rec:
@@ -46,7 +52,9 @@ def detector_figures(bag: Path, topic: str | None, config, far: float, annotated
                 continue
             if v.restart:
                 det.reset()
-            objs = det.detect(r.scan, r.pose).objects
+                aligner.reset()
+            aligned = aligner.align(r.scan, r.pose, r.pose_last_beam)
+            objs = det.detect(aligned.scan, aligned.pose).objects
             scans += 1
             xy = np.array([(o.x, o.y) for o in objs]).reshape(-1, 2)
             people = gt_by_scan.get(r.index, np.zeros((0, 2)))
@@ -70,6 +78,7 @@ def main(argv=None) -> int:
     ap.add_argument("--topic")
     ap.add_argument("--config")
     ap.add_argument("--far", type=float, default=1.0, help="metres from every annotated person (1.0)")
+    ap.add_argument("--no-matching", action="store_true", help="odometry (or nothing) alone, no scan matching")
     args = ap.parse_args(argv)
     try:
         config = load_config(args.config)
@@ -81,7 +90,7 @@ def main(argv=None) -> int:
             if not bag.exists():
                 print(f"{bag.name:<34} not found (the real recordings live in ../shared/data)")
                 continue
-            f = detector_figures(bag, topic, config, args.far, annotated)
+            f = detector_figures(bag, topic, config, args.far, annotated, not args.no_matching)
             pct = lambda v: "n/a" if v != v else f"{100 * v:.1f} %"  # noqa: E731
             print(f"{bag.name + (' ' + topic if topic else ''):<34} {f['scans']:>5} {f['gt_people']:>6} "
                   f"{pct(f['within_0.3m']):>8} {pct(f['within_0.5m']):>8} {f['detections_per_scan']:>9.2f} "
