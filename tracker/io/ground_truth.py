@@ -7,7 +7,6 @@ contract (``scan_index,person_id,x,y``).
 
 from __future__ import annotations
 
-import csv
 import logging
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,6 +15,7 @@ import numpy as np
 
 from tracker.errors import InputError
 from tracker.io.bag import LASER_SCAN, PERSON_TYPES, connections_of, open_bag, select_topic
+from tracker.io.csv_table import read_rows
 
 log = logging.getLogger(__name__)
 
@@ -95,29 +95,8 @@ def read_bag_ground_truth(path: str | Path, scan_topic: str | None = None,
 
 def read_gt_csv(path: str | Path) -> GroundTruth:
     """Ground truth from a CSV with the header ``scan_index,person_id,x,y`` (extra columns ignored)."""
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"ground truth '{p}' does not exist" if not p.exists() else f"ground truth '{p}' is not a file")
-    rows = []
-    try:
-        with p.open(newline="", encoding="utf-8") as fh:
-            reader = csv.DictReader(fh)
-            if reader.fieldnames is None:
-                raise InputError(f"ground truth '{p}' is empty")
-            missing = [c for c in GT_COLUMNS if c not in reader.fieldnames]
-            if missing:
-                raise InputError(f"ground truth '{p}' lacks the column(s) {', '.join(missing)} (needs {','.join(GT_COLUMNS)})")
-            for line, row in enumerate(reader, start=2):
-                try:
-                    k, pid = int(row["scan_index"]), int(row["person_id"])
-                    x, y = float(row["x"]), float(row["y"])
-                except (TypeError, ValueError):
-                    raise InputError(f"ground truth '{p}' line {line}: not a valid row") from None
-                if k < 0 or not (np.isfinite(x) and np.isfinite(y)):
-                    raise InputError(f"ground truth '{p}' line {line}: scan_index must be >= 0 and x, y finite")
-                rows.append((k, pid, x, y))
-    except UnicodeDecodeError:
-        raise InputError(f"ground truth '{p}' is not a text CSV file") from None
+    rows = read_rows(path, "ground truth", GT_COLUMNS, lambda row: (
+        int(row["scan_index"]), int(row["person_id"]), float(row["x"]), float(row["y"])))
     return _make(None, rows)
 
 
