@@ -80,6 +80,11 @@ def _build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--duration", type=float, metavar="S", help="override the scenario's duration, seconds")
     sim.add_argument("--format", choices=("mcap", "sqlite3", "ros1"), default="mcap",
                      help="ROS 2 bag storage (mcap, sqlite3) or a ROS 1 .bag (default: mcap)")
+    bench = sub.add_parser("bench", help="accuracy and speed on every recording and simulated scene")
+    bench.add_argument("--data", metavar="DIR", help="folder of recordings (default: $PEOPLE_TRACKER_DATA, "
+                       "else ../shared/data)")
+    bench.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
+    bench.add_argument("--quick", action="store_true", help="the first 200 scans and 6 s scenes")
     return p
 
 
@@ -242,6 +247,18 @@ def _cmd_simulate(args) -> int:
     return 0
 
 
+def _cmd_bench(args) -> int:
+    from tracker.bench import run_bench
+    from tracker.config import load_config
+
+    config = load_config(args.config)
+    data = Path(args.data or os.environ.get("PEOPLE_TRACKER_DATA") or "../shared/data")
+    if args.data and not data.is_dir():
+        raise InputError(f"data folder '{data}' does not exist")
+    run_bench(config, data, args.quick, sys.stdout)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``people-tracker`` console script; returns the exit status."""
     argv = sys.argv[1:] if argv is None else argv
@@ -251,7 +268,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
     _setup_logging(args.quiet)
-    commands = {"run": _cmd_run, "evaluate": _cmd_evaluate, "simulate": _cmd_simulate}
+    commands = {"run": _cmd_run, "evaluate": _cmd_evaluate, "simulate": _cmd_simulate, "bench": _cmd_bench}
     try:
         return commands[args.command](args)
     except InputError as exc:

@@ -109,3 +109,21 @@ def test_cli_bad_inputs(tmp_path, tracks, args, words):
                    "--json", str(tmp_path / "out.json"))
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and words in proc.stderr
     assert "Traceback" not in proc.stderr and not (tmp_path / "out.json").exists()
+
+
+def test_bench_prints_one_row_per_recording_topic_and_scene(tmp_path):
+    data = tmp_path / "data"
+    data.mkdir()
+    proc = run_cli("simulate", "crossing", "--output", str(data / "cross.bag"), "--format", "ros1", "--duration", "4")
+    assert proc.returncode == 0, proc.stderr
+    proc = run_cli("bench", "--quick", "--data", str(data))
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert lines[1].split()[:4] == ["input", "scans", "MOTA", "%"]
+    rec = next(ln for ln in lines if ln.startswith("cross.bag /scan"))
+    assert rec.split()[2] != "n/a" and float(rec.split()[2]) >= 0  # tracks per minute: two people crossing
+    for scene in ("crossing", "stop_and_go", "occlusion", "following", "corridor", "crowd"):
+        row = next(ln for ln in lines if ln.startswith(f"simulated {scene} "))
+        assert float(row.split()[-4]) > 0  # scans per second
+    assert "Joint Leg Tracker MOTA 10.2 %" in lines[-1]
+    assert run_cli("bench", "--data", str(tmp_path / "nope")).returncode == 2
