@@ -79,11 +79,12 @@ class Detection:
     compared_dt_s: tuple[float, ...]
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(eq=False)
 class _Past:
     scan: Scan
     pose: Pose2D | None
     tree: cKDTree  # the valid readings, in the scan's own sensor frame
+    moving: np.ndarray | None = None  # per beam: labelled moving when it was the current scan
 
 
 def _tree(scan: Scan) -> cKDTree:
@@ -143,11 +144,29 @@ class MovingObjectDetector:
         self.params = params or DetectorParams()
         self._history: deque[_Past] = deque()
         self._next_id = 1
-        self._keep_s = 1.5 * max(self.params.compare_dt_s) + 1.0
+        self._keep_s = 1.5 * max(self.params.compare_dt_s) + 1.5  # also the free-space lookbacks (tracker)
 
     def reset(self) -> None:
         """Forget the history (after a stamp jump or a change of scanner)."""
         self._history.clear()
+
+    def earlier_scans(self, stamp: float, lookbacks_s: tuple[float, ...]) -> list[tuple[Scan, Pose2D, np.ndarray]]:
+        """For each lookback, the kept scan nearest ``stamp - lookback`` (at least half that
+        long ago), with its world pose and per-beam moving mask; scans without a pose, or
+        lookbacks longer than the history, give nothing."""
+        out, seen = [], set()
+        for lookback in lookbacks_s:
+            best = None
+            for past in self._history:
+                age = stamp - past.scan.stamp
+                if age >= 0.5 * lookback and past.pose is not None and (
+                        best is None or abs(age - lookback) < abs(stamp - best.scan.stamp - lookback)):
+                    best = past
+            if best is not None and id(best) not in seen:
+                seen.add(id(best))
+                moving = best.moving if best.moving is not None else np.zeros(best.scan.n_beams, dtype=bool)
+                out.append((best.scan, best.pose, moving))
+        return out
 
     def _earlier(self, stamp: float) -> list[_Past]:
         """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""
@@ -174,7 +193,8 @@ class MovingObjectDetector:
         p = self.params
         earlier = self._earlier(scan.stamp)
         tree = _tree(scan)
-        self._history.append(_Past(scan, pose, tree))
+        current = _Past(scan, pose, tree)
+        self._history.append(current)
         while self._history and self._history[0].scan.stamp < scan.stamp - self._keep_s:
             self._history.popleft()
         if not earlier:
@@ -184,6 +204,7 @@ class MovingObjectDetector:
             rel = pose.between(past.pose) if pose is not None and past.pose is not None else Pose2D()
             pairs.append(label_pair(scan, past.scan, rel, p, tree, past.tree))
         labels = combine(pairs)
+        current.moving = labels == MOVING
         # 3. segments of each set, over the valid readings in beam order
         valid = np.flatnonzero(scan.valid)
         pts = scan.points[valid]

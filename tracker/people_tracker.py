@@ -15,6 +15,7 @@ import numpy as np
 
 from detection.align import Alignment, AlignParams, ScanAligner
 from detection.detector import Detection, DetectorParams, MovingObjectDetector
+from detection.free_space import seen_through
 from models.pose import Pose2D
 from models.scan import Scan
 from tracker.association import associate, mahalanobis_costs
@@ -42,6 +43,12 @@ class AssociationParams:
         Static support must also lie this close to where the track's last moving
         candidate put it (m): a standing leg or a pausing person stays where their legs
         were last seen moving, so a coasting track cannot slide from clutter to clutter.
+    free_space_lookback_s, free_space_margin_m : float
+        A candidate starts a track only where one of the scans about ½, 1 and 1½ times
+        ``free_space_lookback_s`` earlier saw at least ``free_space_margin_m`` past it (the
+        place was empty: someone walked in). Static surfaces that look moving (misaligned,
+        or flickering between a return and none) were never seen through. 0 s turns the
+        test off.
     """
 
     method: str = "gnn"
@@ -51,6 +58,8 @@ class AssociationParams:
     support_sigma_m: float = 0.12
     support_min_points: int = 3
     support_anchor_m: float = 0.5
+    free_space_lookback_s: float = 1.0
+    free_space_margin_m: float = 0.3
 
 
 @dataclass(frozen=True, eq=False)
@@ -172,8 +181,17 @@ class PeopleTracker:
 
     def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float) -> None:
         known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
+        fresh = [ci for ci in range(len(candidates)) if ci not in used]
+        free = np.ones(len(candidates), dtype=bool)
+        if fresh and self.assoc.free_space_lookback_s > 0:
+            xy = np.array([(candidates[ci].x, candidates[ci].y) for ci in fresh])
+            seen = np.zeros(len(fresh), dtype=bool)
+            lookback = self.assoc.free_space_lookback_s
+            for scan, pose, moving in self.detector.earlier_scans(stamp, (0.5 * lookback, lookback, 1.5 * lookback)):
+                seen |= seen_through(xy, scan, pose, self.assoc.free_space_margin_m, moving)
+            free[fresh] = seen
         for ci, c in enumerate(candidates):
-            if ci in used:
+            if ci in used or not free[ci]:
                 continue
             if len(known) and np.hypot(*(known - (c.x, c.y)).T).min() < self.assoc.spawn_exclusion_m:
                 continue

@@ -137,3 +137,19 @@ def test_detector_finds_an_object_that_appears_and_keeps_history_by_time():
     det.reset()
     assert det.detect(_wall_scan(0.2, blob_at=90)).compared_dt_s == ()
 
+
+
+def test_free_space_sees_through_empty_places_only():
+    from detection.free_space import seen_through
+    ranges = np.array([5.0, np.inf, np.nan, 2.0, 2.0, 0.0])
+    scan = Scan(ranges, -0.25, 0.1, 0.05, 10.0, stamp=0.0)  # beams at -0.25 … 0.25 rad
+    pose = Pose2D(1.0, 0.0, 0.0)  # the sensor 1 m along x in the world
+    ang = scan.angles
+    pts = np.column_stack([1.0 + 3.0 * np.cos(ang), 3.0 * np.sin(ang)])  # 3 m out along each beam
+    moving = np.array([False, False, False, True, False, False])
+    free = seen_through(pts, scan, pose, 0.3, moving)
+    # beyond (5 m), no return (inf), lost (nan: unknown), blocked by a moving reading,
+    # blocked by a static one, lost (0: unknown)
+    assert free.tolist() == [True, True, False, True, False, False]
+    behind = seen_through(np.array([[-5.0, 0.0]]), scan, pose, 0.3)  # outside the field of view
+    assert behind.tolist() == [False]
