@@ -14,6 +14,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from tracker.errors import InputError
 
 PROG = "people-tracker"
@@ -59,6 +61,8 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--detections", metavar="FILE.csv", help="write the moving objects of every scan")
     run.add_argument("--tracks", metavar="FILE.csv", help="write the confirmed people of every scan")
     run.add_argument("--follow", metavar="auto|ID", help="follow a person: the closest ahead (auto) or a track id")
+    run.add_argument("--rrd", metavar="FILE.rrd", help="save a rerun recording of every stage")
+    run.add_argument("--spawn", action="store_true", help="open the rerun viewer and stream to it")
 
     ev = sub.add_parser("evaluate", help="score a tracks CSV against ground truth (CLEAR MOT, IDF1, OSPA)")
     ev.add_argument("tracks", metavar="TRACKS.csv", help="needs the columns scan_index,track_id,x,y")
@@ -106,12 +110,9 @@ def _print_v_min(params, resolution: float) -> None:
 def _cmd_run(args) -> int:
     import contextlib
 
-    from tracker.config import dump_config, load_config
-    from tracker.io import outputs
-    from tracker.io.atomic import atomic_output, check_writable
+    from tracker.config import load_config
+    from tracker.io.atomic import check_writable
     from tracker.io.recording import Recording
-    from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
-    from tracker.scan_checks import ScanChecker
 
     config = load_config(args.config)
     follow = None
@@ -119,19 +120,62 @@ def _cmd_run(args) -> int:
         if args.follow != "auto" and not args.follow.isdigit():
             raise InputError(f"--follow takes auto or a track id, got '{args.follow}'")
         follow = args.follow if args.follow == "auto" else int(args.follow)
-    for out in (args.detections, args.tracks):
+    if args.input is None and args.topic:
+        raise InputError("--topic needs an INPUT recording")
+    for out in (args.detections, args.tracks, args.rrd):
         if out:
             check_writable(out)
-    log = logging.getLogger(PROG)
     t0 = time.perf_counter()
-    if args.input is None:
-        from tracker.io.simulated import DEFAULT_SCENE, SimulatedSource
-        if args.topic:
-            raise InputError("--topic needs an INPUT recording")
-        source = SimulatedSource(DEFAULT_SCENE)
-    else:
-        source = Recording(args.input, args.topic, config.odometry)
-    stack = contextlib.ExitStack()
+    truth = _ground_truth_by_scan(args.input, args.topic) if (args.rrd or args.spawn) and args.input else None
+    sink = _make_sink(args)
+    try:
+        if args.input is None:
+            from tracker.io.simulated import DEFAULT_SCENE, SimulatedSource
+            source = SimulatedSource(DEFAULT_SCENE)
+        else:
+            source = Recording(args.input, args.topic, config.odometry)
+        _run_loop(args, config, follow, source, contextlib.ExitStack(), sink, truth, t0)
+    except BaseException:
+        sink.abort()
+        raise
+    sink.close()
+    return 0
+
+
+def _ground_truth_by_scan(path, topic) -> dict | None:
+    """Sensor-frame ground truth per scan index of an annotated recording (None without)."""
+    from tracker.io.bag import PERSON_TYPES, open_bag, topics_of_type
+    from tracker.io.ground_truth import read_bag_ground_truth
+
+    reader = open_bag(path)
+    annotated = bool(topics_of_type(reader, PERSON_TYPES))
+    reader.close()
+    if not annotated:
+        return None
+    gt = read_bag_ground_truth(path, topic)
+    out: dict = {}
+    for k, x, y in zip(gt.scan_index.tolist(), gt.x, gt.y):
+        out.setdefault(k, []).append((x, y))
+    return out
+
+
+def _make_sink(args):
+    from tracker.sinks import NullSink
+
+    if not (args.rrd or args.spawn):
+        return NullSink()
+    from tracker.viz_rerun import RerunSink
+    return RerunSink(args.rrd, args.spawn)
+
+
+def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
+    from tracker.config import dump_config
+    from tracker.io import outputs
+    from tracker.io.atomic import atomic_output
+    from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+    from tracker.scan_checks import ScanChecker
+
+    log = logging.getLogger(PROG)
     with source as rec, stack:
         det_file = stack.enter_context(atomic_output(args.detections)) if args.detections else None
         trk_file = stack.enter_context(atomic_output(args.tracks)) if args.tracks else None
@@ -161,7 +205,17 @@ def _cmd_run(args) -> int:
                 scan = record.scan
                 if verdict.restart:
                     tracker.reset()
+                t_step = time.perf_counter()
                 tracks = tracker.step(scan, record.pose, record.pose_last_beam)
+                latency = time.perf_counter() - t_step
+                if truth is not None:
+                    sink_truth = np.array(truth.get(record.index, []), dtype=float).reshape(-1, 2)
+                elif getattr(rec, "truths", None):
+                    tr = rec.truths[-1]
+                    sink_truth = tr.torso_sensor[tr.visible]
+                else:
+                    sink_truth = None
+                sink.scan(record.index, scan.stamp, tracker.last, latency, sink_truth)
                 found = tracker.last.detection
                 n_objects += len(found.objects)
                 n_track_rows += len(tracks)
@@ -201,7 +255,8 @@ def _cmd_run(args) -> int:
             if out:
                 with atomic_output(f"{out}.config.yaml") as fh:
                     fh.write(dump_config(config))
-    return 0
+        if args.rrd:
+            print(f"rerun recording: {args.rrd} (open it with: rerun {args.rrd})")
 
 
 def _cmd_evaluate(args) -> int:

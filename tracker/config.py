@@ -118,6 +118,7 @@ class AssociationConfig:
     support_anchor_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
     free_space_lookback_s: float = field(metadata=_spec(lo=0.0, hi=60.0))
     free_space_margin_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
+    recover_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
 
     def params(self):
         from tracker.people_tracker import AssociationParams

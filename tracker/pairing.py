@@ -66,7 +66,17 @@ class PersonCandidate:
         return np.eye(2) * self.sigma ** 2
 
 
-def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: PairingParams) -> list[PersonCandidate]:
+def owners(xy: np.ndarray, predictions: np.ndarray, radius: float) -> np.ndarray:
+    """For each object, the index of the nearest predicted person within ``radius`` metres, else -1."""
+    if len(xy) == 0 or len(predictions) == 0:
+        return np.full(len(xy), -1, dtype=np.int64)
+    d = np.hypot(xy[:, None, 0] - predictions[None, :, 0], xy[:, None, 1] - predictions[None, :, 1])
+    nearest = d.argmin(axis=1)
+    return np.where(d[np.arange(len(xy)), nearest] <= radius, nearest, -1)
+
+
+def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: PairingParams,
+              groups: np.ndarray | None = None) -> list[PersonCandidate]:
     """Person candidates from moving objects.
 
     Parameters
@@ -77,6 +87,9 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
         Longest side of each object's bounding rectangle, metres.
     ids : list of int
         Object ids.
+    groups : ndarray of int, shape (k,), optional
+        Owner of each object (-1 for none, see :func:`owners`): two legs owned by two
+        different people never pair, so two people passing close never pair across.
     """
     legs = np.flatnonzero(sizes <= params.max_leg_size_m)
     blobs = np.flatnonzero((sizes > params.max_leg_size_m) & (sizes <= params.max_person_size_m))
@@ -87,6 +100,9 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
         d = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
         a, b = np.triu_indices(len(legs), k=1)
         close = d[a, b] <= params.max_leg_separation_m
+        if groups is not None:  # never two legs that belong to two different people
+            ga, gb = groups[legs[a]], groups[legs[b]]
+            close &= (ga == gb) | (ga < 0) | (gb < 0)
         a, b = a[close], b[close]
         for k in np.argsort(d[a, b], kind="stable"):  # nearest pairs first, each leg once
             i, j = int(legs[a[k]]), int(legs[b[k]])

@@ -20,7 +20,7 @@ from models.pose import Pose2D
 from models.scan import Scan
 from tracker.association import associate, mahalanobis_costs
 from tracker.following import TargetSelector
-from tracker.pairing import PairingParams, PersonCandidate, pair_legs
+from tracker.pairing import PairingParams, PersonCandidate, owners, pair_legs
 from tracker.static_support import static_support
 from tracker.tracks import Track, TrackParams, TrackState
 
@@ -60,6 +60,7 @@ class AssociationParams:
     support_anchor_m: float = 0.5
     free_space_lookback_s: float = 1.0
     free_space_margin_m: float = 0.3
+    recover_radius_m: float = 0.8
 
 
 @dataclass(frozen=True, eq=False)
@@ -125,10 +126,11 @@ class PeopleTracker:
         aligned = self.aligner.align(scan, pose, pose_last_beam, people)  # 0. de-skew and align
         scan, world = aligned.scan, aligned.pose
         detection = self.detector.detect(scan, world)  # 1. moving objects (sensor frame)
-        candidates = self._candidates(detection, world)  # 2. legs paired into people (world frame)
-        for t in self._tracks:  # 3. predict every track to the scan time
+        for t in self._tracks:  # 2. predict every track to the scan time
             t.predict(scan.stamp)
+        candidates = self._candidates(detection, world)  # 3. legs paired into people (world frame)
         matched = self._associate(candidates)  # 4. associate candidates to tracks
+        matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
         for ti, ci in matched:  # 5. update the matched tracks
             c = candidates[ci]
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
@@ -147,7 +149,10 @@ class PeopleTracker:
         if not objs:
             return []
         xy = world.transform_points(np.array([(o.x, o.y) for o in objs]))
-        return pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing)
+        # legs near a tracked person are that person's: never paired with another person's
+        people = np.array([t.position for t in self._tracks if t.confirmed]).reshape(-1, 2)
+        groups = owners(xy, people, 0.5 * self.pairing.max_leg_separation_m)
+        return pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups)
 
     def _associate(self, candidates: list[PersonCandidate]) -> list[tuple[int, int]]:
         if not self._tracks or not candidates:
@@ -164,6 +169,22 @@ class PeopleTracker:
         rest = np.where(~confirmed[:, None], cost, np.inf)
         rest[:, list(taken_c)] = np.inf
         return pairs + associate(rest, self.assoc.gate_chi2, self.assoc.method)
+
+    def _recover(self, candidates: list[PersonCandidate], matched: list[tuple[int, int]]) -> list[tuple[int, int]]:
+        taken_t, taken_c = {t for t, _ in matched}, {c for _, c in matched}
+        # only tracks that lost their person within the last second
+        idle = [i for i, t in enumerate(self._tracks)
+                if t.confirmed and i not in taken_t and t.stamp - t.last_moving_update <= 1.0]
+        free = [k for k in range(len(candidates)) if k not in taken_c]
+        if not idle or not free or self.assoc.recover_radius_m <= 0:
+            return []
+        anchors = np.array([self._tracks[i].moving_position for i in idle])
+        z = np.array([(candidates[k].x, candidates[k].y) for k in free])
+        d = np.hypot(anchors[:, None, 0] - z[None, :, 0], anchors[:, None, 1] - z[None, :, 1])
+        pairs = associate(d, self.assoc.recover_radius_m, "gnn")
+        for a, _ in pairs:
+            self._tracks[idle[a]].forget_velocity()
+        return [(idle[a], free[b]) for a, b in pairs]
 
     def _support(self, scan: Scan, world: Pose2D, matched: set[int]) -> None:
         idle = [i for i, t in enumerate(self._tracks) if t.confirmed and i not in matched]

@@ -111,6 +111,14 @@ class TrackState:
             self.stamp = stamp
         self.updated_now = False
 
+    def forget_velocity(self) -> None:
+        """Reset the velocity's uncertainty to a new track's (after a sharp turn)."""
+        v = self.params.init_speed_std_mps ** 2
+        for i in (1, 3):
+            self.kf.P[i, :] = 0.0
+            self.kf.P[:, i] = 0.0
+            self.kf.P[i, i] = v
+
     def update(self, z: np.ndarray, R: np.ndarray, moving: bool) -> None:
         """Correct with a candidate position ``z`` (m) of covariance ``R`` (m²)."""
         # y = z - H x ; S = H P Hᵀ + R ; K = P Hᵀ S⁻¹ ; x = x + K y ; P = (I - K H) P

@@ -142,3 +142,16 @@ def test_filter_is_consistent_nees_within_chi2_bounds():
     lo, hi = chi2.ppf(0.025, 4 * runs) / runs, chi2.ppf(0.975, 4 * runs) / runs
     inside = (mean >= lo) & (mean <= hi)
     assert inside.mean() >= 0.9, (mean.round(2), lo, hi)
+
+
+def test_legs_of_two_people_never_pair_across():
+    p = PairingParams()
+    # two people passing 0.4 m apart: their nearest legs are 0.2 m apart, each person's own 0.5 m
+    xy = np.array([[2.7, 0.0], [2.7, 0.5], [2.9, 0.3], [3.2, -0.2]])
+    sizes = np.full(4, 0.12)
+    from tracker.pairing import owners
+    groups = owners(xy, np.array([[2.7, 0.25], [3.1, 0.05]]), 0.4)
+    pairs = sorted(c.object_ids for c in pair_legs(xy, sizes, [1, 2, 3, 4], p, groups) if c.kind == "pair")
+    assert pairs == [(1, 2), (3, 4)]
+    # without the tracks, the nearest legs would pair across the two people
+    assert (2, 3) in [c.object_ids for c in pair_legs(xy, sizes, [1, 2, 3, 4], p) if c.kind == "pair"]
