@@ -146,11 +146,13 @@ def test_filter_is_consistent_nees_within_chi2_bounds():
 
 def test_legs_of_two_people_never_pair_across():
     p = PairingParams()
-    # two people passing 0.4 m apart: their nearest legs are 0.2 m apart, each person's own 0.5 m
-    xy = np.array([[2.7, 0.0], [2.7, 0.5], [2.9, 0.3], [3.2, -0.2]])
+    # two people passing 0.4 m apart, A at x = 2.7 and B at x = 3.1: their nearest legs are
+    # 0.43 m apart, each person's own 0.5 m and 0.6 m
+    xy = np.array([[2.7, 0.0], [2.7, 0.5], [3.1, 0.35], [3.1, -0.25]])
     sizes = np.full(4, 0.12)
     from tracker.pairing import owners
     groups = owners(xy, np.array([[2.7, 0.25], [3.1, 0.05]]), 0.4)
+    assert groups.tolist() == [0, 0, 1, 1]
     pairs = sorted(c.object_ids for c in pair_legs(xy, sizes, [1, 2, 3, 4], p, groups) if c.kind == "pair")
     assert pairs == [(1, 2), (3, 4)]
     # without the tracks, the nearest legs would pair across the two people
