@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 from detection.closest import closest_point_static
 from detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
 from detection.objects import MovingObject, describe
-from detection.recover import recover_moving
+from detection.recover import isolated_occluded, recover_moving
 from detection.scan_lines import bin_to_beams, scan_line_labels
 from detection.segments import split_runs
 from detection.thresholds import range_threshold
@@ -47,6 +47,9 @@ class DetectorParams:
         Join refuses to grow an object beyond this end-to-end length.
     single_object_max_o
         Algorithm 3 runs when O_C has at most this many segments (the single-object condition).
+    isolated_o_objects
+        Also take free-standing, person-sized O segments as objects moving away, whatever
+        else moves (an extension of Algorithm 3; see :func:`detection.recover.isolated_occluded`).
     """
 
     k_closest: float = 6.0
@@ -59,6 +62,7 @@ class DetectorParams:
     min_object_points: int = 3
     max_object_size_m: float = 1.0
     single_object_max_o: int = 1
+    isolated_o_objects: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -213,6 +217,12 @@ class MovingObjectDetector:
         # 4. Algorithms 2 and 3: recover whole objects
         found = recover_moving(runs, pts, gap, p.min_seed_points, p.min_object_points, p.max_object_size_m,
                                p.single_object_max_o)
+        if p.isolated_o_objects and found and not all(r.label == OCCLUDED for r in found):
+            taken = {(r.start, r.stop) for r in found}
+            found += [r for r in isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
+                                                   p.max_object_size_m) if (r.start, r.stop) not in taken]
+        elif p.isolated_o_objects and not found:
+            found = isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points, p.max_object_size_m)
         # 5. position and box of each object big enough
         objects = []
         for seg in found:

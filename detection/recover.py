@@ -43,6 +43,32 @@ def join(runs: list[Segment], into: int, source: int, points: np.ndarray, join_t
     return joined_any
 
 
+def isolated_occluded(runs: list[Segment], points: np.ndarray, ranges: np.ndarray, gap: np.ndarray,
+                      min_points: int, max_extent: float) -> list[Segment]:
+    """O segments that stand in front of both neighbours: objects moving away.
+
+    An object that moves away from the scanner lies wholly in O_C (the paper's case 3).
+    Algorithm 3 recovers it only when the scene holds a single moving object. This
+    extension takes, whatever else moves, each O segment of ``min_points`` readings and at
+    most ``max_extent`` metres end to end whose readings on either side are farther by more
+    than the segment spacing threshold (or are missing): a free-standing thing, unlike
+    the background a passing person reveals, which continues into the static surface
+    beside it.
+    """
+    out = []
+    n = len(points)
+    for r in runs:
+        if r.label != OCCLUDED or r.size < min_points:
+            continue
+        if np.hypot(*(points[r.stop - 1] - points[r.start])) > max_extent:
+            continue
+        left_ok = r.start == 0 or ranges[r.start - 1] > ranges[r.start] + gap[r.start]
+        right_ok = r.stop == n or ranges[r.stop] > ranges[r.stop - 1] + gap[r.stop - 1]
+        if left_ok and right_ok:
+            out.append(r)
+    return out
+
+
 def recover_moving(runs: list[Segment], points: np.ndarray, join_threshold: np.ndarray, min_seed: int,
                    min_points: int, max_extent: float, single_object_max_o: int) -> list[Segment]:
     """Algorithms 2 and 3: the segments that are moving objects.

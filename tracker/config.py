@@ -59,6 +59,7 @@ class DetectorConfig:
     min_object_points: int = field(metadata=_spec(lo=1, hi=10000))
     max_object_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
     single_object_max_o: int = field(metadata=_spec(lo=0, hi=10000))
+    isolated_o_objects: bool = field(metadata=_spec())
 
     def params(self):
         """The detector's own parameter object."""
