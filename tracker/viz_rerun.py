@@ -142,9 +142,9 @@ class RerunSink(Sink):
             [_ellipse(np.array([t.x, t.y]), np.array(t.position_cov)) for t in tracks],
             colors=[_colour(t.track_id) for t in tracks], radii=0.01))
         heading = np.array([math.cos(pose.yaw), math.sin(pose.yaw)]) * 0.5
-        rec.log("world/robot", rr.Arrows2D(origins=[(pose.x, pose.y)], vectors=[heading], colors=(80, 80, 255)))
+        rec.log("world/robot", rr.Arrows2D(origins=[(pose.x, pose.y)], vectors=[heading], colors=(210, 210, 210)))
         self._path.append((pose.x, pose.y))
-        rec.log("world/robot/path", rr.LineStrips2D([np.array(self._path)], colors=(80, 80, 255), radii=0.02))
+        rec.log("world/robot/path", rr.LineStrips2D([np.array(self._path)], colors=(210, 210, 210), radii=0.02))
         if truth_sensor is not None:
             rec.log("world/ground_truth", rr.Points2D(pose.transform_points(np.asarray(truth_sensor).reshape(-1, 2)),
                                                       colors=(255, 255, 255), radii=0.1))
@@ -158,7 +158,7 @@ class RerunSink(Sink):
             [np.array(self._history[i]) for i in ids], colors=[_colour(i) for i in ids], radii=0.03,
             labels=[str(i) for i in ids]), static=True)
         if self._path:
-            self.rec.log("world/overview/robot_path", rr.LineStrips2D([np.array(self._path)], colors=(80, 80, 255),
+            self.rec.log("world/overview/robot_path", rr.LineStrips2D([np.array(self._path)], colors=(210, 210, 210),
                                                                      radii=0.03), static=True)
         self.rec.flush()
         self.rec.disconnect()
