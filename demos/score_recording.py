@@ -13,17 +13,10 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
-import numpy as np
-
+from tracker.bench import bench_recording
 from tracker.config import load_config
-from tracker.evaluation import TrackRows, evaluate
-from tracker.io.ground_truth import GroundTruth, read_bag_ground_truth
-from tracker.io.recording import Recording
-from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
-from tracker.scan_checks import ScanChecker
 
 DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
 PUBLISHED = {"mota": 0.102, "motp_m": 0.15, "id_switches": 2, "misses": 480, "false_positives": 97, "matches": 163}
@@ -39,32 +32,11 @@ def main(argv=None) -> int:
         print(f"score_recording: '{path}' not found (the annotated recording lives in ../shared/data/leigh/)",
               file=sys.stderr)
         return 2
-    config = load_config()
-    tracker = PeopleTracker.from_config(config)
-    checker = ScanChecker(config.scan_checks.stamp_jump_periods, config.scan_checks.beam_count_confirm)
-    limit = 300 if args.short else None
-    rows = []
-    t0 = time.perf_counter()
-    with Recording(path, None, config.odometry) as rec:
-        for r in rec.scans():
-            if limit is not None and r.index >= limit:
-                break
-            v = checker.check(r.scan, r.problem)
-            if not v.use:
-                continue
-            if v.restart:
-                tracker.reset()
-            tracks = tracker.step(r.scan, r.pose, r.pose_last_beam)
-            rows += [(r.index, t.track_id, x, y) for t, (x, y) in zip(tracks, tracks_in_sensor_frame(tracks, tracker.last.pose))]
-    elapsed = time.perf_counter() - t0
-    gt = read_bag_ground_truth(path)
-    if limit is not None:
-        keep = gt.scan_index < limit
-        gt = GroundTruth(min(gt.n_frames, limit), gt.scan_index[keep], gt.person_id[keep], gt.x[keep], gt.y[keep])
-    a = np.array(rows, dtype=float).reshape(-1, 4)
-    res = evaluate(gt, TrackRows(a[:, 0].astype(np.int64), a[:, 1].astype(np.int64), a[:, 2], a[:, 3]))
+    row = bench_recording(path, None, load_config(), 300 if args.short else None)
+    res = row.result
+    elapsed = sum(row.seconds)
     print(f"score_recording: {path.name}, {res['frames']} scans in {elapsed:.1f} s "
-          f"({res['frames'] / elapsed:.0f} scans/s), Leigh et al.'s protocol (0.75 m)")
+          f"({row.scans / elapsed:.0f} scans/s), Leigh et al.'s protocol (0.75 m)")
     print(f"{'':<18} {'people-tracker':>15} {'Joint Leg Tracker (published)':>31}")
     for key, label, fmt in (("mota", "MOTA", "{:.1%}"), ("motp_m", "MOTP (m)", "{:.3f}"),
                             ("id_switches", "id switches", "{}"), ("misses", "misses", "{}"),
