@@ -51,11 +51,14 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         seg_of[r.start:r.stop] = i
     pred_sensor = pose.inverse().transform_points(predictions_world)
     d = np.hypot(pts[None, :, 0] - pred_sensor[:, None, 0], pts[None, :, 1] - pred_sensor[:, None, 1])
+    chosen = np.zeros(len(runs), dtype=bool)
     for t in range(len(pred_sensor)):
-        near = np.unique(seg_of[d[t] <= radius_m])
+        near = seg_of[d[t] <= radius_m]
         if len(near) == 0:
             continue
-        members = np.isin(seg_of, near)
+        chosen[:] = False
+        chosen[near] = True
+        members = chosen[seg_of]
         p = pts[members]
         if len(p) < min_points or np.hypot(*np.ptp(p, axis=0)) > max_size_m:
             continue

@@ -147,7 +147,10 @@ class TrackState:
             return True
         if self.stamp - self.last_moving_update > p.max_static_s:
             return True
-        return math.sqrt(float(np.linalg.eigvalsh(self.position_cov).max())) > p.max_position_std_m
+        (a, b), (_, c) = self.position_cov
+        # largest eigenvalue of the 2x2 covariance [[a, b], [b, c]]
+        largest = 0.5 * (a + c) + math.sqrt(0.25 * (a - c) ** 2 + b * b)
+        return math.sqrt(max(largest, 0.0)) > p.max_position_std_m
 
     def confidence(self) -> float:
         """Share of recent scans with an update, faded by the time since the last one."""
