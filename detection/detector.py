@@ -217,12 +217,10 @@ class MovingObjectDetector:
         # 4. Algorithms 2 and 3: recover whole objects
         found = recover_moving(runs, pts, gap, p.min_seed_points, p.min_object_points, p.max_object_size_m,
                                p.single_object_max_o)
-        if p.isolated_o_objects and found and not all(r.label == OCCLUDED for r in found):
+        if p.isolated_o_objects:  # objects moving away, whatever else moves (extends Algorithm 3)
             taken = {(r.start, r.stop) for r in found}
             found += [r for r in isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
                                                    p.max_object_size_m) if (r.start, r.stop) not in taken]
-        elif p.isolated_o_objects and not found:
-            found = isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points, p.max_object_size_m)
         # 5. position and box of each object big enough
         objects = []
         for seg in found:
