@@ -157,10 +157,6 @@ class Walker:
         """Torso position (the ground truth) at time ``t``, world frame, metres."""
         return self._at(self.arc_length(t))[0]
 
-    def velocity(self, t: float, dt: float = 1e-3) -> np.ndarray:
-        """Torso velocity at time ``t``, m/s."""
-        return (self.torso(t + dt) - self.torso(t - dt)) / (2 * dt)
-
     def _footprint(self, k: int) -> np.ndarray:
         p, u = self._at((k + 0.5) * self.body.step_length)
         side = 1.0 if k % 2 == 0 else -1.0  # even footprints left of the path, odd right

@@ -26,7 +26,7 @@ import numpy as np
 from tracker.config import Config
 from tracker.errors import InputError
 from tracker.evaluation import TrackRows, evaluate
-from tracker.io.bag import LASER_SCAN, PERSON_TYPES, open_bag, topics_of_type
+from tracker.io.bag import LASER_SCAN, open_bag, topics_of_type
 from tracker.io.ground_truth import GroundTruth, read_bag_ground_truth
 from tracker.io.recording import Recording
 from tracker.io.simulated import SimulatedSource
@@ -81,14 +81,11 @@ def _track_rows(rows) -> TrackRows:
 
 
 def bench_recording(path: Path, topic: str, config: Config, limit: int | None) -> Row:
-    reader = open_bag(path)
-    annotated = bool(topics_of_type(reader, PERSON_TYPES))
-    reader.close()
     with Recording(path, topic, config.odometry) as rec:
         rows, times, ids, span = _run(rec, config, timed_read=True, limit=limit)
     row = Row(f"{path.name} {topic}", len(times), times)
-    if annotated:
-        gt = read_bag_ground_truth(path, topic)
+    gt = read_bag_ground_truth(path, topic, required=False)
+    if gt is not None:
         if limit is not None:
             keep = gt.scan_index < limit
             gt = GroundTruth(min(gt.n_frames, limit), gt.scan_index[keep], gt.person_id[keep], gt.x[keep], gt.y[keep])

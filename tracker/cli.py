@@ -144,15 +144,11 @@ def _cmd_run(args) -> int:
 
 def _ground_truth_by_scan(path, topic) -> dict | None:
     """Sensor-frame ground truth per scan index of an annotated recording (None without)."""
-    from tracker.io.bag import PERSON_TYPES, open_bag, topics_of_type
     from tracker.io.ground_truth import read_bag_ground_truth
 
-    reader = open_bag(path)
-    annotated = bool(topics_of_type(reader, PERSON_TYPES))
-    reader.close()
-    if not annotated:
+    gt = read_bag_ground_truth(path, topic, required=False)
+    if gt is None:
         return None
-    gt = read_bag_ground_truth(path, topic)
     out: dict = {}
     for k, x, y in zip(gt.scan_index.tolist(), gt.x, gt.y):
         out.setdefault(k, []).append((x, y))

@@ -85,10 +85,6 @@ def connections_of(reader: AnyReader, topic: str) -> list:
     return [c for c in reader.connections if c.topic == topic]
 
 
-def is_ros1(reader: AnyReader) -> bool:
-    return not reader.is2
-
-
 def peek_stamp(raw: bytes | memoryview, ros1: bool) -> float:
     """Header stamp (s) of a serialized message that starts with ``std_msgs/Header``.
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from tracker.errors import InputError
-from tracker.io.bag import LASER_SCAN, PERSON_TYPES, connections_of, open_bag, select_topic
+from tracker.io.bag import LASER_SCAN, PERSON_TYPES, connections_of, open_bag, select_topic, topics_of_type
 from tracker.io.csv_table import read_rows
 
 log = logging.getLogger(__name__)
@@ -53,15 +53,18 @@ def _make(n_frames, rows) -> GroundTruth:
 
 
 def read_bag_ground_truth(path: str | Path, scan_topic: str | None = None,
-                          gt_topic: str | None = None) -> GroundTruth:
+                          gt_topic: str | None = None, required: bool = True) -> GroundTruth | None:
     """Ground truth of an annotated recording.
 
     Every message of the scan topic is a frame. A person message is stamped (bag time)
     between the scan it annotates and the next one, so it belongs to the last scan whose
-    bag time is at or before its own.
+    bag time is at or before its own. With ``required=False`` a recording without a
+    ground-truth topic gives None instead of an error.
     """
     reader = open_bag(path)
     try:
+        if not required and gt_topic is None and not topics_of_type(reader, PERSON_TYPES):
+            return None
         scan_topic = select_topic(reader, scan_topic, LASER_SCAN, "LaserScan", "--topic")
         gt_topic = select_topic(reader, gt_topic, PERSON_TYPES, "ground-truth (leg_tracker/Person)", "--gt-topic")
         scan_conns = connections_of(reader, scan_topic)
