@@ -34,8 +34,9 @@ def deskew(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> Scan:
     -------
     Scan
         Same beam grid, stamp and limits. Each reading goes to the beam nearest its new
-        bearing (the nearest reading wins where two meet); a beam left without one is
-        ``nan``.
+        bearing (the nearest reading wins where two meet); a beam that saw nothing
+        (``inf``, see :attr:`Scan.no_return`) stays ``inf`` unless a reading lands on it; any
+        other beam left without one is ``nan``.
     """
     motion = pose_first.between(pose_last)  # the sweep's motion, in the first beam's frame
     if scan.n_beams < 2 or (abs(motion.x) < 1e-6 and abs(motion.y) < 1e-6 and abs(motion.yaw) < 1e-7):
@@ -56,7 +57,7 @@ def deskew(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> Scan:
     if scan.angle_increment < 0:
         idx = np.rint(-wrap_angle(scan.angle_min - bearing) / abs(scan.angle_increment)).astype(np.int64)
     keep = (idx >= 0) & (idx < n) & (new_r > scan.range_min) & (new_r < scan.range_max)
-    out = np.full(n, np.nan)
+    out = np.where(scan.no_return, np.inf, np.nan)  # the sweep moves a line of sight by under a beam
     order = np.argsort(-new_r[keep])  # farthest first, so the nearest reading in a beam is written last
     out[idx[keep][order]] = new_r[keep][order]
     return Scan(out, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max, scan.stamp,

@@ -50,6 +50,21 @@ class DetectorParams:
     isolated_o_objects
         Also take free-standing, person-sized O segments as objects moving away, whatever
         else moves (an extension of Algorithm 3; see :func:`detection.recover.isolated_occluded`).
+    no_return_free_m
+        A previous beam with no return (``inf``, REP 117) counts as a line of sight seen
+        through up to this range (m; capped at range_max) in Algorithm 1, so a reading in
+        front of it is moving rather than out of view; 0 turns it off. Dark surfaces also
+        give no return, hence a limit.
+    static_memory_s, static_memory_k, static_memory_share
+        An extension for static things that flicker (thin or dark objects that return a
+        reading in one scan and none in the next, so they look newly arrived): an object is
+        dropped when at least ``static_memory_share`` of its readings had a reading of one of
+        the scans about ``static_memory_s`` seconds earlier within ``static_memory_k`` times
+        Δd_c of them (world frame). A walking leg is never twice at one place that long
+        apart; a post the robot drives past always is. ``static_memory_k`` 0 turns it off.
+        A reading counts as remembered when ``static_memory_min_scans`` of those scans saw
+        it; objects within ``static_memory_keep_m`` of a tracked person are kept (a person
+        turning back stands where they stood a moment before).
     """
 
     k_closest: float = 6.0
@@ -63,6 +78,12 @@ class DetectorParams:
     max_object_size_m: float = 1.0
     single_object_max_o: int = 1
     isolated_o_objects: bool = True
+    no_return_free_m: float = 0.0
+    static_memory_s: tuple[float, ...] = (0.9, 1.2, 1.5)
+    static_memory_k: float = 1.5
+    static_memory_share: float = 0.3
+    static_memory_min_scans: int = 1
+    static_memory_keep_m: float = 1.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,8 +139,15 @@ def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
     # 2. Algorithm 1 on B_C, B_P: the previous readings binned to the current beams
     b_c = valid_c[~static_c]
     beam_all = bin_to_beams(pts_p, scan.angle_min, scan.angle_increment, scan.n_beams)
+    # lines of sight the previous scan saw through (no return): free up to no_return_free_m
+    far = np.flatnonzero(prev.no_return) if params.no_return_free_m > 0 else np.zeros(0, dtype=np.int64)
+    a = prev.angles[far]
+    reach = min(prev.range_max, params.no_return_free_m)
+    pts_far = rel.transform_points(reach * np.column_stack([np.cos(a), np.sin(a)]))
+    beam_seen = np.concatenate([beam_all, bin_to_beams(pts_far, scan.angle_min, scan.angle_increment, scan.n_beams)])
+    r_seen = np.concatenate([r_p, np.hypot(pts_far[:, 0], pts_far[:, 1])])
     label_c, _ = scan_line_labels(b_c, scan.ranges[b_c], beam_all[~static_p], r_p[~static_p], scan.n_beams,
-                                  params.scan_line_window, beam_all, r_p)
+                                  params.scan_line_window, beam_seen, r_seen)
     labels[b_c] = label_c
     return labels
 
@@ -148,7 +176,8 @@ class MovingObjectDetector:
         self.params = params or DetectorParams()
         self._history: deque[_Past] = deque()
         self._next_id = 1
-        self._keep_s = 1.5 * max(self.params.compare_dt_s) + 1.5  # also the free-space lookbacks (tracker)
+        # also the free-space lookbacks of the tracker (up to 1.5 s)
+        self._keep_s = max(1.5 * max(self.params.compare_dt_s), max(self.params.static_memory_s)) + 1.5
 
     def reset(self) -> None:
         """Forget the history (after a stamp jump or a change of scanner)."""
@@ -158,19 +187,59 @@ class MovingObjectDetector:
         """For each lookback, the kept scan nearest ``stamp - lookback`` (at least half that
         long ago), with its world pose and per-beam moving mask; scans without a pose, or
         lookbacks longer than the history, give nothing."""
-        out, seen = [], set()
+        out = []
+        for best in self._lookback(stamp, lookbacks_s, need_pose=True):
+            moving = best.moving if best.moving is not None else np.zeros(best.scan.n_beams, dtype=bool)
+            out.append((best.scan, best.pose, moving))
+        return out
+
+    def _lookback(self, stamp: float, lookbacks_s: tuple[float, ...], need_pose: bool) -> list[_Past]:
+        """For each lookback, the kept scan nearest ``stamp - lookback`` and at least half
+        that long ago; each scan once."""
+        out: list[_Past] = []
         for lookback in lookbacks_s:
             best = None
             for past in self._history:
                 age = stamp - past.scan.stamp
-                if age >= 0.5 * lookback and past.pose is not None and (
+                if age >= 0.5 * lookback and (past.pose is not None or not need_pose) and (
                         best is None or abs(age - lookback) < abs(stamp - best.scan.stamp - lookback)):
                     best = past
-            if best is not None and id(best) not in seen:
-                seen.add(id(best))
-                moving = best.moving if best.moving is not None else np.zeros(best.scan.n_beams, dtype=bool)
-                out.append((best.scan, best.pose, moving))
+            if best is not None and all(best is not o for o in out):
+                out.append(best)
         return out
+
+    def _static_memory(self, scan: Scan, pose: Pose2D | None, objects: list[MovingObject],
+                       people: np.ndarray | None = None) -> list[MovingObject]:
+        """The objects whose place was not occupied in the scans about ``static_memory_s``
+        earlier (see :class:`DetectorParams`); objects within ``static_memory_keep_m`` of
+        ``people`` (tracked persons, sensor frame) are kept whatever the memory says: a
+        person turning back or stepping on the spot stands where they stood before."""
+        p = self.params
+        if not objects or p.static_memory_k <= 0:
+            return objects
+        if people is not None and len(people):
+            xy = np.array([(o.x, o.y) for o in objects])
+            d = np.hypot(xy[:, None, 0] - people[None, :, 0], xy[:, None, 1] - people[None, :, 1]).min(axis=1)
+            near = d <= p.static_memory_keep_m
+            if near.any():
+                rest = self._static_memory(scan, pose, [o for o, n in zip(objects, near) if not n])
+                keep = {o.object_id for o in rest}
+                return [o for o, n in zip(objects, near) if n or o.object_id in keep]
+        memory = self._lookback(scan.stamp, p.static_memory_s, need_pose=pose is not None)
+        if not memory:
+            return objects
+        beams = np.concatenate([o.beams for o in objects])
+        pts = np.concatenate([o.points for o in objects])
+        thr = range_threshold(scan.ranges[beams], scan.resolution, p.static_memory_k * p.k_closest,
+                              p.static_memory_k * p.closest_floor_m)
+        seen = np.zeros(len(pts), dtype=np.int64)
+        for past in memory:
+            rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
+            d, _ = past.tree.query(rel.transform_points(pts), distance_upper_bound=float(thr.max()))
+            seen += d <= thr
+        seen = seen >= p.static_memory_min_scans
+        bounds = np.cumsum([0] + [len(o.beams) for o in objects])
+        return [o for o, a, b in zip(objects, bounds[:-1], bounds[1:]) if seen[a:b].mean() < p.static_memory_share]
 
     def _earlier(self, stamp: float) -> list[_Past]:
         """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""
@@ -185,7 +254,7 @@ class MovingObjectDetector:
                 chosen.append(past)
         return chosen
 
-    def detect(self, scan: Scan, pose: Pose2D | None = None) -> Detection:
+    def detect(self, scan: Scan, pose: Pose2D | None = None, people: np.ndarray | None = None) -> Detection:
         """Labels and moving objects of ``scan``.
 
         Parameters
@@ -193,6 +262,9 @@ class MovingObjectDetector:
         scan : Scan
         pose : Pose2D, optional
             Sensor pose in the fixed frame; without it the sensor is taken as still.
+        people : ndarray, shape (k, 2), optional
+            Tracked people in this scan's sensor frame, metres: the static-memory test
+            leaves objects near them alone.
         """
         p = self.params
         earlier = self._earlier(scan.stamp)
@@ -228,6 +300,7 @@ class MovingObjectDetector:
                 continue
             objects.append(describe(self._next_id, valid[seg.start:seg.stop], pts[seg.start:seg.stop], seg.sets))
             self._next_id += 1
+        objects = self._static_memory(scan, pose, objects, people)
         return Detection(labels, objects, tuple(scan.stamp - e.scan.stamp for e in earlier))
 
 

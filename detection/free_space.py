@@ -14,10 +14,12 @@ from models.scan import Scan
 
 
 def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: float,
-                 moving: np.ndarray | None = None) -> np.ndarray:
+                 moving: np.ndarray | None = None, no_return_free_m: float = np.inf) -> np.ndarray:
     """Whether ``scan`` (taken at ``pose``, world frame) saw past each point by ``margin_m``.
 
-    A beam with no return (``inf``, beyond ``range_max``) saw through everything. A lost
+    A beam with no return (``inf``, beyond ``range_max``) saw through everything up to
+    ``no_return_free_m`` (m; dark surfaces return nothing either, so a user may trust it
+    only so far, or not at all with 0). A lost
     reading (``nan``, ``0``) tells nothing: surfaces that flicker between a return and none
     (dark, shiny, glass) are exactly what looks moving when it is not. A point outside
     the field of view tells nothing either (False).
@@ -38,7 +40,7 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
     inside = beam >= 0
     r = np.full(len(local), -1.0)  # outside the view: neither free nor blocked
     r[inside] = scan.ranges[beam[inside]]
-    no_return = np.isposinf(r) | (np.isfinite(r) & (r >= scan.range_max))
+    no_return = (np.isposinf(r) | (np.isfinite(r) & (r >= scan.range_max))) & (dist + margin_m <= no_return_free_m)
     beyond = np.isfinite(r) & (r > scan.range_min) & (r > dist + margin_m)
     free = no_return | beyond
     if moving is not None:

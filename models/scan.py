@@ -68,6 +68,17 @@ class Scan:
         mask.setflags(write=False)
         return mask
 
+    @cached_property
+    def no_return(self) -> np.ndarray:
+        """Boolean mask, shape (n,): beams that saw nothing within range (``+inf`` or at or
+        beyond range_max, REP 117): the line of sight was free up to range_max. ``nan`` and
+        ``0`` (a lost reading) say nothing and are not included."""
+        r = self.ranges
+        with np.errstate(invalid="ignore"):
+            mask = np.isposinf(r) | (np.isfinite(r) & (r >= self.range_max))
+        mask.setflags(write=False)
+        return mask
+
     @property
     def n_valid(self) -> int:
         """Number of valid readings."""

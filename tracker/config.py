@@ -60,6 +60,12 @@ class DetectorConfig:
     max_object_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
     single_object_max_o: int = field(metadata=_spec(lo=0, hi=10000))
     isolated_o_objects: bool = field(metadata=_spec())
+    no_return_free_m: float = field(metadata=_spec(lo=0.0, hi=1000.0))
+    static_memory_s: tuple = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    static_memory_k: float = field(metadata=_spec(lo=0.0, hi=1000.0))
+    static_memory_share: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1.0))
+    static_memory_min_scans: int = field(metadata=_spec(lo=1, hi=100))
+    static_memory_keep_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
 
     def params(self):
         """The detector's own parameter object."""
@@ -75,6 +81,7 @@ def _params_of(section, cls):
 class PairingConfig:
     """Leg pairing; see :class:`tracker.pairing.PairingParams`."""
 
+    min_leg_size_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
     max_leg_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
     max_person_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     max_leg_separation_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))

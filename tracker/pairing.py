@@ -19,6 +19,10 @@ class PairingParams:
 
     Attributes
     ----------
+    min_leg_size_m : float
+        Shortest longest-side of an object that can be a leg: a leg 5 cm or more in radius
+        shows a chord of several centimetres even when partly hidden; thinner things (posts,
+        cables, chair legs) are not people.
     max_leg_size_m : float
         Longest side of an object that can be one leg.
     max_person_size_m : float
@@ -30,6 +34,7 @@ class PairingParams:
         person-sized object.
     """
 
+    min_leg_size_m: float = 0.04
     max_leg_size_m: float = 0.3
     max_person_size_m: float = 0.8
     max_leg_separation_m: float = 0.8
@@ -91,7 +96,7 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
         Owner of each object (-1 for none, see :func:`owners`): two legs owned by two
         different people never pair, so two people passing close never pair across.
     """
-    legs = np.flatnonzero(sizes <= params.max_leg_size_m)
+    legs = np.flatnonzero((sizes >= params.min_leg_size_m) & (sizes <= params.max_leg_size_m))
     blobs = np.flatnonzero((sizes > params.max_leg_size_m) & (sizes <= params.max_person_size_m))
     out = [PersonCandidate(float(xy[i, 0]), float(xy[i, 1]), params.sigma_blob_m, "blob", (ids[i],)) for i in blobs]
     paired = set()

@@ -125,7 +125,8 @@ class PeopleTracker:
         people = np.array([t.position for t in self._tracks if t.confirmed]).reshape(-1, 2)
         aligned = self.aligner.align(scan, pose, pose_last_beam, people)  # 0. de-skew and align
         scan, world = aligned.scan, aligned.pose
-        detection = self.detector.detect(scan, world)  # 1. moving objects (sensor frame)
+        # 1. moving objects (sensor frame)
+        detection = self.detector.detect(scan, world, world.inverse().transform_points(people) if len(people) else None)
         for t in self._tracks:  # 2. predict every track to the scan time
             t.predict(scan.stamp)
         candidates = self._candidates(detection, world)  # 3. legs paired into people (world frame)
@@ -209,7 +210,8 @@ class PeopleTracker:
             seen = np.zeros(len(fresh), dtype=bool)
             lookback = self.assoc.free_space_lookback_s
             for scan, pose, moving in self.detector.earlier_scans(stamp, (0.5 * lookback, lookback, 1.5 * lookback)):
-                seen |= seen_through(xy, scan, pose, self.assoc.free_space_margin_m, moving)
+                seen |= seen_through(xy, scan, pose, self.assoc.free_space_margin_m, moving,
+                                     self.detector.params.no_return_free_m)
             free[fresh] = seen
         for ci, c in enumerate(candidates):
             if ci in used or not free[ci]:

@@ -153,3 +153,60 @@ def test_free_space_sees_through_empty_places_only():
     assert free.tolist() == [True, True, False, True, False, False]
     behind = seen_through(np.array([[-5.0, 0.0]]), scan, pose, 0.3)  # outside the field of view
     assert behind.tolist() == [False]
+
+
+def test_a_flickering_post_is_static_clutter_but_a_walker_is_not():
+    """A thin post that returns a reading only now and then looks newly arrived each time it
+    does; the static memory remembers its place from ~0.9-1.5 s earlier and drops it. A blob
+    that moves 8 beams (~28 cm at 2 m) a scan is never where it was that long ago and is kept."""
+    params = DetectorParams(compare_dt_s=(0.1,))
+    post = MovingObjectDetector(params)
+    seen_post = []
+    for k in range(25):
+        visible = k >= 3 and k % 3 == 0  # the post's beams return a reading one scan in three
+        d = post.detect(_wall_scan(0.1 * k, blob_at=90 if visible else None))
+        if visible:
+            seen_post.append(len(d.objects))
+    assert seen_post[0] == 1  # first sighting: nothing to remember
+    assert seen_post[-5:] == [0] * 5  # once the memory reaches back to a sighting it has it
+    walker = MovingObjectDetector(params)
+    seen_walker = [len(walker.detect(_wall_scan(0.1 * k, blob_at=20 + 8 * k)).objects) for k in range(19)]
+    assert seen_walker[1:] == [1] * 18
+    off = MovingObjectDetector(DetectorParams(compare_dt_s=(0.1,), static_memory_k=0.0))
+    counts = [len(off.detect(_wall_scan(0.1 * k, blob_at=90 if k >= 3 and k % 3 == 0 else None)).objects)
+              for k in range(25)]
+    assert counts[-1] == 1  # with the memory off the paper's detector flags it every time
+
+
+def test_static_memory_keeps_objects_near_a_tracked_person():
+    params = DetectorParams(compare_dt_s=(0.1,))
+    det = MovingObjectDetector(params)
+    for k in range(24):
+        det.detect(_wall_scan(0.1 * k, blob_at=90 if k % 3 == 0 else None))
+    person = np.array([[2.0, 0.3]])  # 0.3 m from the blob, sensor frame
+    assert len(det.detect(_wall_scan(2.4, blob_at=90), people=person).objects) == 1
+
+
+def test_no_return_counts_as_seen_through_only_when_asked():
+    ang = np.radians(np.linspace(-90, 90, 181))
+    far = Scan(np.full(181, np.inf), ang[0], ang[1] - ang[0], 0.05, 10.0, stamp=0.0)  # nothing in range
+    r = np.full(181, np.inf)
+    r[88:93] = 2.0
+    now = Scan(r, ang[0], ang[1] - ang[0], 0.05, 10.0, stamp=0.1)
+    off = label_pair(now, far, Pose2D(), DetectorParams())
+    assert (off[88:93] == OUT_OF_VIEW).all()
+    on = label_pair(now, far, Pose2D(), DetectorParams(no_return_free_m=5.0))
+    assert (on[88:93] == MOVING).all()
+    short = label_pair(now, far, Pose2D(), DetectorParams(no_return_free_m=1.5))  # trusted only to 1.5 m
+    assert (short[88:93] == OCCLUDED).all()
+
+
+def test_deskew_keeps_no_return_beams():
+    from detection.deskew import deskew
+    r = np.full(181, 4.0)
+    r[100:120] = np.inf
+    ang = np.radians(np.linspace(-90, 90, 181))
+    s = Scan(r, ang[0], ang[1] - ang[0], 0.05, 10.0, stamp=0.0, time_increment=1e-4)
+    out = deskew(s, Pose2D(), Pose2D(0.02, 0.0, 0.0))
+    assert np.isposinf(out.ranges[102:118]).all() and out.no_return[102:118].all()
+    assert not out.no_return[:90].any()

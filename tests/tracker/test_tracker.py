@@ -84,6 +84,7 @@ def test_leg_pairing():
     pair = next(k for k in c if k.kind == "pair")
     assert (pair.x, pair.y) == pytest.approx((1.0, 0.15)) and pair.sigma < next(k for k in c if k.kind == "leg").sigma
     assert pair_legs(xy[:1], np.array([1.5]), [9], p) == []  # too big for a person
+    assert pair_legs(xy[:1], np.array([0.02]), [9], p) == []  # too thin for a leg (a post, a cable)
 
 
 def test_lifecycle_exactly():
