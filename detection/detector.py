@@ -208,38 +208,41 @@ class MovingObjectDetector:
                 out.append(best)
         return out
 
-    def _static_memory(self, scan: Scan, pose: Pose2D | None, objects: list[MovingObject],
-                       people: np.ndarray | None = None) -> list[MovingObject]:
-        """The objects whose place was not occupied in the scans about ``static_memory_s``
-        earlier (see :class:`DetectorParams`); objects within ``static_memory_keep_m`` of
-        ``people`` (tracked persons, sensor frame) are kept whatever the memory says: a
-        person turning back or stepping on the spot stands where they stood before."""
+    def _static_memory(self, scan: Scan, pose: Pose2D | None, spans: list[tuple[int, int]], pts: np.ndarray,
+                       ranges: np.ndarray, people: np.ndarray | None = None) -> np.ndarray:
+        """Which candidate objects (``spans`` of ``pts``, the valid readings in beam order,
+        sensor frame) to keep: those whose place was not occupied in the scans about
+        ``static_memory_s`` earlier (see :class:`DetectorParams`). Objects within
+        ``static_memory_keep_m`` of ``people`` (tracked persons, sensor frame) are kept
+        whatever the memory says: a person turning back stands where they stood before."""
         p = self.params
-        if not objects or p.static_memory_k <= 0:
-            return objects
-        if people is not None and len(people):
-            xy = np.array([(o.x, o.y) for o in objects])
-            d = np.hypot(xy[:, None, 0] - people[None, :, 0], xy[:, None, 1] - people[None, :, 1]).min(axis=1)
-            near = d <= p.static_memory_keep_m
-            if near.any():
-                rest = self._static_memory(scan, pose, [o for o, n in zip(objects, near) if not n])
-                keep = {o.object_id for o in rest}
-                return [o for o, n in zip(objects, near) if n or o.object_id in keep]
+        keep = np.ones(len(spans), dtype=bool)
+        if not spans or p.static_memory_k <= 0:
+            return keep
         memory = self._lookback(scan.stamp, p.static_memory_s, need_pose=pose is not None)
         if not memory:
-            return objects
-        beams = np.concatenate([o.beams for o in objects])
-        pts = np.concatenate([o.points for o in objects])
-        thr = range_threshold(scan.ranges[beams], scan.resolution, p.static_memory_k * p.k_closest,
+            return keep
+        test = np.arange(len(spans))
+        if people is not None and len(people):
+            xy = np.array([pts[a:b].mean(axis=0) for a, b in spans])
+            d = np.hypot(xy[:, None, 0] - people[None, :, 0], xy[:, None, 1] - people[None, :, 1]).min(axis=1)
+            test = test[d > p.static_memory_keep_m]
+        if not len(test):
+            return keep
+        idx = np.concatenate([np.arange(*spans[k]) for k in test])
+        q = pts[idx]
+        thr = range_threshold(ranges[idx], scan.resolution, p.static_memory_k * p.k_closest,
                               p.static_memory_k * p.closest_floor_m)
-        seen = np.zeros(len(pts), dtype=np.int64)
+        seen = np.zeros(len(q), dtype=np.int64)
         for past in memory:
             rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
-            d, _ = past.tree.query(rel.transform_points(pts), distance_upper_bound=float(thr.max()))
+            d, _ = past.tree.query(rel.transform_points(q), distance_upper_bound=float(thr.max()))
             seen += d <= thr
-        seen = seen >= p.static_memory_min_scans
-        bounds = np.cumsum([0] + [len(o.beams) for o in objects])
-        return [o for o, a, b in zip(objects, bounds[:-1], bounds[1:]) if seen[a:b].mean() < p.static_memory_share]
+        remembered = (seen >= p.static_memory_min_scans).astype(float)
+        sizes = np.array([spans[k][1] - spans[k][0] for k in test])
+        share = np.add.reduceat(remembered, np.concatenate([[0], np.cumsum(sizes)[:-1]])) / sizes
+        keep[test[share >= p.static_memory_share]] = False
+        return keep
 
     def _earlier(self, stamp: float) -> list[_Past]:
         """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""
@@ -293,14 +296,15 @@ class MovingObjectDetector:
             taken = {(r.start, r.stop) for r in found}
             found += [r for r in isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
                                                    p.max_object_size_m) if (r.start, r.stop) not in taken]
+        found = [seg for seg in found if seg.size >= p.min_object_points]
+        # static things that flicker are not moving (extension, see DetectorParams)
+        keep = self._static_memory(scan, pose, [(seg.start, seg.stop) for seg in found], pts,
+                                   scan.ranges[valid], people)
         # 5. position and box of each object big enough
         objects = []
-        for seg in found:
-            if seg.size < p.min_object_points:
-                continue
+        for seg in (seg for seg, k in zip(found, keep) if k):
             objects.append(describe(self._next_id, valid[seg.start:seg.stop], pts[seg.start:seg.stop], seg.sets))
             self._next_id += 1
-        objects = self._static_memory(scan, pose, objects, people)
         return Detection(labels, objects, tuple(scan.stamp - e.scan.stamp for e in earlier))
 
 
