@@ -40,7 +40,9 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
     inside = beam >= 0
     r = np.full(len(local), -1.0)  # outside the view: neither free nor blocked
     r[inside] = scan.ranges[beam[inside]]
-    no_return = (np.isposinf(r) | (np.isfinite(r) & (r >= scan.range_max))) & (dist + margin_m <= no_return_free_m)
+    no_return = np.zeros(len(local), dtype=bool)
+    no_return[inside] = scan.no_return[beam[inside]]
+    no_return &= dist + margin_m <= no_return_free_m
     beyond = np.isfinite(r) & (r > scan.range_min) & (r > dist + margin_m)
     free = no_return | beyond
     if moving is not None:

@@ -71,8 +71,8 @@ def scan_line_labels(beam_c: np.ndarray, range_c: np.ndarray, beam_p: np.ndarray
         Its range from the current sensor origin, metres.
 
     beam_all, range_all : ndarray, optional
-        Every valid previous reading (static ones too), and a point at range_max on each
-        previous beam with no return, binned and ranged the same way.
+        Every valid previous reading (static ones too), and a point on each previous beam
+        with no return as far as it is trusted to be free, binned and ranged the same way.
         A B_C reading with no B_P partner is compared with these before it is called N:
         a reading in front of a surface the previous scan saw on the same line of sight is
         moving even though that surface is static (an object's edge against the
