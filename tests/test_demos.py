@@ -36,4 +36,5 @@ def test_crowd_monitor_reports_count_zones_and_flow(tmp_path):
 def test_score_recording_prints_the_table_beside_the_published_figures(tmp_path):
     bag = data_file("leigh/general_tracking_moving_1.bag")
     out = run_demo("score_recording.py", str(bag), "--short", cwd=tmp_path)
-    assert "Joint Leg Tracker (published)" in out and "MOTA" in out and "10.2%" in out
+    assert "Joint Leg Tracker (published, -80..12 deg)" in out and "MOTA" in out and "10.2%" in out
+    assert "all bearings" in out and "ground truth" in out

@@ -74,6 +74,9 @@ def _build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--gt-topic", help="ground-truth topic (leg_tracker/Person) of the recording")
     ev.add_argument("--ospa-cutoff", type=float, default=1.0, metavar="M", help="OSPA cut-off c, metres (1.0)")
     ev.add_argument("--ospa-order", type=float, default=1.0, metavar="P", help="OSPA order p (1)")
+    ev.add_argument("--bearing-window", type=float, nargs=2, metavar=("MIN", "MAX"),
+                    help="score only people and tracks at sensor-frame bearings MIN..MAX, degrees "
+                         "(Leigh et al. used -80 12 on the moving-robot recordings)")
     ev.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
 
     sim = sub.add_parser("simulate", help="render a simulated scenario to a ROS 2 bag (MCAP) with ground truth")
@@ -267,11 +270,15 @@ def _cmd_evaluate(args) -> int:
                         ("--ospa-order", args.ospa_order)):
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"{name} must be a positive number, got {value}")
+    window = args.bearing_window
+    if window is not None and not (all(math.isfinite(b) and -180 <= b <= 180 for b in window) and window[0] < window[1]):
+        raise InputError(f"--bearing-window needs MIN < MAX, both in -180..180 degrees, got {window[0]:g} {window[1]:g}")
     if args.json:
         check_writable(args.json)
     tracks = read_tracks_csv(args.tracks)
     gt = read_ground_truth(args.ground_truth, args.topic, args.gt_topic)
-    result = evaluate(gt, tracks, args.protocol, args.threshold, args.ospa_cutoff, args.ospa_order)
+    result = evaluate(gt, tracks, args.protocol, args.threshold, args.ospa_cutoff, args.ospa_order,
+                      bearing_window_deg=None if window is None else tuple(window))
     result["tracks_file"] = str(args.tracks)
     result["ground_truth_file"] = str(args.ground_truth)
     print(format_table(result))

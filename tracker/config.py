@@ -134,6 +134,27 @@ class AssociationConfig:
 
 
 @dataclass(frozen=True)
+class StandingConfig:
+    """Standing people found by leg shape; see :class:`tracker.standing.StandingParams`."""
+
+    enabled: bool = field(metadata=_spec())
+    min_points: int = field(metadata=_spec(lo=1, hi=10000))
+    max_leg_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
+    edge_jump_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
+    max_range_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
+    min_leg_separation_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
+    max_leg_separation_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
+    confirm_scans: int = field(metadata=_spec(lo=1, hi=1000))
+    confirm_window: int = field(metadata=_spec(lo=1, hi=1000))
+    confirm_radius_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    furniture_radius_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
+
+    def params(self):
+        from tracker.standing import StandingParams
+        return _params_of(self, StandingParams)
+
+
+@dataclass(frozen=True)
 class AlignmentConfig:
     """Scan matching; see :class:`detection.align.AlignParams` and :class:`detection.icp.IcpParams`."""
 
@@ -168,6 +189,7 @@ class Config:
     pairing: PairingConfig
     tracks: TracksConfig
     association: AssociationConfig
+    standing: StandingConfig
     alignment: AlignmentConfig
 
     def to_dict(self) -> dict:

@@ -12,11 +12,16 @@ Protocols (Leigh et al.):
 
 Every scan is a frame, including scans where nobody is annotated (a reported person
 there is a false positive). Positions are compared in the sensor frame.
+
+A bearing window (Leigh et al.'s ``constrain_to_specific_angle``) drops the ground-truth
+people and the tracks whose sensor-frame bearing ``atan2(y, x)`` lies outside it before
+matching, in every frame. Their published moving-robot figures use −80°..12°: the part of
+the left laser's view that the annotators labelled (ahead of the robot).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
@@ -61,7 +66,8 @@ def ospa(gt_xy: np.ndarray, tr_xy: np.ndarray, cutoff: float, order: float) -> f
 
 
 def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", threshold: float = 0.75,
-             ospa_cutoff: float = 1.0, ospa_order: float = 1.0, n_frames: int | None = None) -> dict:
+             ospa_cutoff: float = 1.0, ospa_order: float = 1.0, n_frames: int | None = None,
+             bearing_window_deg: tuple[float, float] | None = None) -> dict:
     """Score ``tracks`` against ``gt``.
 
     Parameters
@@ -75,6 +81,8 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
         OSPA's cut-off c (metres) and order p.
     n_frames : int, optional
         Number of frames; default ``gt.n_frames`` or the largest index seen plus one.
+    bearing_window_deg : (float, float), optional
+        Keep only people and tracks whose sensor-frame bearing lies in [min, max], degrees.
 
     Returns
     -------
@@ -89,6 +97,8 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
     if protocol == "following" and tracks.target is not None:
         keep = tracks.target == 1
         tracks = TrackRows(tracks.scan_index[keep], tracks.track_id[keep], tracks.x[keep], tracks.y[keep], tracks.target[keep])
+    if bearing_window_deg is not None:
+        gt, tracks = _in_window(gt, bearing_window_deg), _in_window(tracks, bearing_window_deg)
     last = max(int(gt.scan_index.max(initial=-1)), int(tracks.scan_index.max(initial=-1)))
     frames = n_frames if n_frames is not None else (gt.n_frames if gt.n_frames is not None else last + 1)
     frames = max(frames, last + 1)
@@ -129,7 +139,17 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
         "ospa_m": float(ospas.mean()) if frames else float("nan"),
         "ospa_cutoff_m": ospa_cutoff,
         "ospa_order": ospa_order,
+        "bearing_window_deg": None if bearing_window_deg is None else [float(b) for b in bearing_window_deg],
     }
+
+
+def _in_window(rows, window_deg: tuple[float, float]):
+    """The rows (GroundTruth or TrackRows) whose sensor-frame bearing is inside the window."""
+    lo, hi = np.radians(window_deg[0]), np.radians(window_deg[1])
+    bearing = np.arctan2(rows.y, rows.x)
+    keep = (bearing >= lo) & (bearing <= hi)
+    return replace(rows, **{f.name: getattr(rows, f.name)[keep] for f in fields(rows)
+                            if isinstance(getattr(rows, f.name), np.ndarray) and getattr(rows, f.name).shape == keep.shape})
 
 
 def format_table(result: dict) -> str:
@@ -138,7 +158,9 @@ def format_table(result: dict) -> str:
     metres = lambda v: "n/a" if v != v else f"{v:.3f} m"  # noqa: E731
     lines = [
         (f"protocol", f"{result['protocol']} (match within {result['threshold_m']:g} m)"),
-        ("frames", f"{result['frames']}"),
+        ("frames", f"{result['frames']}"
+                   + ("" if result.get("bearing_window_deg") is None else
+                      " (people and tracks with bearing {:g}°..{:g}° only)".format(*result["bearing_window_deg"]))),
         ("ground-truth people", f"{result['ground_truth']}"),
         ("reported tracks", f"{result['tracks_reported']}"),
         ("matches", f"{result['matches']}"),

@@ -80,6 +80,37 @@ def owners(xy: np.ndarray, predictions: np.ndarray, radius: float) -> np.ndarray
     return np.where(d[np.arange(len(xy)), nearest] <= radius, nearest, -1)
 
 
+def nearest_pairs(xy: np.ndarray, min_separation_m: float, max_separation_m: float,
+                  allowed: np.ndarray | None = None) -> list[tuple[int, int]]:
+    """Disjoint pairs of points, nearest first, each point used once.
+
+    Parameters
+    ----------
+    xy : ndarray, shape (k, 2)
+        Points (leg centres), metres, any one frame.
+    min_separation_m, max_separation_m : float
+        Only pairs this far apart, metres.
+    allowed : ndarray of bool, shape (k, k), optional
+        Which pairs may form.
+    """
+    if len(xy) < 2:
+        return []
+    d = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
+    a, b = np.triu_indices(len(xy), k=1)
+    ok = (d[a, b] >= min_separation_m) & (d[a, b] <= max_separation_m)
+    if allowed is not None:
+        ok &= allowed[a, b]
+    a, b = a[ok], b[ok]
+    used: set[int] = set()
+    out = []
+    for k in np.argsort(d[a, b], kind="stable"):
+        i, j = int(a[k]), int(b[k])
+        if i not in used and j not in used:
+            out.append((i, j))
+            used.update((i, j))
+    return out
+
+
 def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: PairingParams,
               groups: np.ndarray | None = None) -> list[PersonCandidate]:
     """Person candidates from moving objects.
@@ -99,23 +130,16 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
     legs = np.flatnonzero((sizes >= params.min_leg_size_m) & (sizes <= params.max_leg_size_m))
     blobs = np.flatnonzero((sizes > params.max_leg_size_m) & (sizes <= params.max_person_size_m))
     out = [PersonCandidate(float(xy[i, 0]), float(xy[i, 1]), params.sigma_blob_m, "blob", (ids[i],)) for i in blobs]
+    allowed = None
+    if groups is not None:  # never two legs that belong to two different people
+        g = groups[legs]
+        allowed = (g[:, None] == g[None, :]) | (g[:, None] < 0) | (g[None, :] < 0)
     paired = set()
-    if len(legs) >= 2:
-        p = xy[legs]
-        d = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
-        a, b = np.triu_indices(len(legs), k=1)
-        close = d[a, b] <= params.max_leg_separation_m
-        if groups is not None:  # never two legs that belong to two different people
-            ga, gb = groups[legs[a]], groups[legs[b]]
-            close &= (ga == gb) | (ga < 0) | (gb < 0)
-        a, b = a[close], b[close]
-        for k in np.argsort(d[a, b], kind="stable"):  # nearest pairs first, each leg once
-            i, j = int(legs[a[k]]), int(legs[b[k]])
-            if i in paired or j in paired:
-                continue
-            mid = 0.5 * (xy[i] + xy[j])
-            out.append(PersonCandidate(float(mid[0]), float(mid[1]), params.sigma_pair_m, "pair", (ids[i], ids[j])))
-            paired.update((i, j))
+    for a, b in nearest_pairs(xy[legs], 0.0, params.max_leg_separation_m, allowed):
+        i, j = int(legs[a]), int(legs[b])
+        mid = 0.5 * (xy[i] + xy[j])
+        out.append(PersonCandidate(float(mid[0]), float(mid[1]), params.sigma_pair_m, "pair", (ids[i], ids[j])))
+        paired.update((i, j))
     out += [PersonCandidate(float(xy[i, 0]), float(xy[i, 1]), params.sigma_single_leg_m, "leg", (ids[i],))
             for i in legs if i not in paired]
     return out

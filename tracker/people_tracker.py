@@ -16,11 +16,13 @@ import numpy as np
 from detection.align import Alignment, AlignParams, ScanAligner
 from detection.detector import Detection, DetectorParams, MovingObjectDetector
 from detection.free_space import seen_through
+from detection.legs import free_standing_legs
 from models.pose import Pose2D
 from models.scan import Scan
 from tracker.association import associate, mahalanobis_costs
 from tracker.following import TargetSelector
 from tracker.pairing import PairingParams, PersonCandidate, owners, pair_legs
+from tracker.standing import StandingInitiator, StandingParams, standing_pairs
 from tracker.static_support import static_support
 from tracker.tracks import Track, TrackParams, TrackState
 
@@ -87,13 +89,15 @@ class PeopleTracker:
 
     def __init__(self, detector: DetectorParams | None = None, pairing: PairingParams | None = None,
                  tracks: TrackParams | None = None, association: AssociationParams | None = None,
-                 follow: str | int | None = None, alignment: AlignParams | None = None) -> None:
+                 follow: str | int | None = None, alignment: AlignParams | None = None,
+                 standing: StandingParams | None = None) -> None:
         self.aligner = ScanAligner(alignment or AlignParams())
         self.detector = MovingObjectDetector(detector or DetectorParams())
         self.pairing = pairing or PairingParams()
         self.track_params = tracks or TrackParams()
         self.assoc = association or AssociationParams()
         self.selector = TargetSelector(follow) if follow is not None else None
+        self.standing = StandingInitiator(standing or StandingParams())
         self._tracks: list[TrackState] = []
         self._next_id = 1
         self.last: StepResult | None = None
@@ -102,12 +106,13 @@ class PeopleTracker:
     def from_config(cls, config, follow: str | int | None = None) -> "PeopleTracker":
         """A tracker from a resolved :class:`tracker.config.Config`."""
         return cls(config.detector.params(), config.pairing.params(), config.tracks.params(),
-                   config.association.params(), follow, config.alignment.params())
+                   config.association.params(), follow, config.alignment.params(), config.standing.params())
 
     def reset(self) -> None:
         """Forget the scan history (a stamp jump, a new scanner); tracks coast on."""
         self.detector.reset()
         self.aligner.reset()
+        self.standing.reset()
 
     def step(self, scan: Scan, pose: Pose2D | None = None, pose_last_beam: Pose2D | None = None) -> list[Track]:
         """Process one scan; return the confirmed tracks (coasting ones included).
@@ -135,12 +140,15 @@ class PeopleTracker:
         for ti, ci in matched:  # 5. update the matched tracks
             c = candidates[ci]
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
-        self._support(scan, world, {ti for ti, _ in matched})  # 6. static support for the unmatched
+        standing = self._standing_candidates(scan, world)  # 6. standing people, found by leg shape
+        matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
+        self._support(scan, world, matched_t)  # 7. static support for the rest
         for t in self._tracks:
             t.record(t.updated_now)
-        self._initiate(candidates, {ci for _, ci in matched}, scan.stamp)  # 7. new tentative tracks
-        self._delete(scan.stamp)  # 8. delete what the lifecycle rules end
-        target = self._follow(world, scan.stamp)  # 9. the followed person
+        self._initiate(candidates, {ci for _, ci in matched}, scan.stamp)  # 8. new tentative tracks
+        self._initiate_standing(standing, scan.stamp)  # 8b. and standing people who persist
+        self._delete(scan.stamp)  # 9. delete what the lifecycle rules end
+        target = self._follow(world, scan.stamp)  # 10. the followed person
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.confirmed]
         self.last = StepResult(reported, detection, candidates, world, scan, aligned)
         return reported
@@ -163,6 +171,13 @@ class PeopleTracker:
         z = np.array([(c.x, c.y) for c in candidates])
         R = np.array([c.R for c in candidates])
         cost = mahalanobis_costs(means, covs, z, R)
+        # a person held still (standing, paused) walks off from where they stood: however wide
+        # their gate has grown, a moving candidate must lie near that place
+        still = np.array([t.held_still for t in self._tracks])
+        if still.any():
+            anchors = np.array([t.moving_position for t in self._tracks])
+            away = np.hypot(anchors[:, None, 0] - z[None, :, 0], anchors[:, None, 1] - z[None, :, 1]) > self.assoc.recover_radius_m
+            cost[still[:, None] & away] = np.inf
         # confirmed tracks choose first: a tentative track never takes a confirmed one's candidate
         confirmed = np.array([t.confirmed for t in self._tracks])
         pairs = associate(np.where(confirmed[:, None], cost, np.inf), self.assoc.gate_chi2, self.assoc.method)
@@ -201,6 +216,50 @@ class PeopleTracker:
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
                 t.update(z, R, moving=False)
 
+    def _standing_candidates(self, scan: Scan, world: Pose2D) -> list[PersonCandidate]:
+        p = self.standing.params
+        if not p.enabled:
+            return []
+        d = self.detector.params
+        legs = free_standing_legs(scan, d.k_segment, d.segment_floor_m, p.min_points, self.pairing.min_leg_size_m,
+                                  p.max_leg_size_m, p.edge_jump_m, p.max_range_m)
+        mids = standing_pairs(legs, p)
+        xy = world.transform_points(mids) if len(mids) else mids
+        return [PersonCandidate(float(x), float(y), self.pairing.sigma_pair_m, "standing") for x, y in xy]
+
+    def _update_standing(self, standing: list[PersonCandidate]) -> set[int]:
+        """Standing pairs update confirmed tracks no moving candidate reached; their indices."""
+        idle = [i for i, t in enumerate(self._tracks) if t.confirmed and not t.updated_now]
+        if not idle or not standing:
+            return set()
+        means = np.array([self._tracks[i].position for i in idle])
+        covs = np.array([self._tracks[i].position_cov for i in idle])
+        z = np.array([(c.x, c.y) for c in standing])
+        cost = mahalanobis_costs(means, covs, z, np.array([c.R for c in standing]))
+        # like static support, a pair must lie near where the track last moved (or was born standing)
+        anchors = np.array([self._tracks[i].moving_position for i in idle])
+        far = np.hypot(anchors[:, None, 0] - z[None, :, 0], anchors[:, None, 1] - z[None, :, 1]) > self.assoc.support_anchor_m
+        cost[far] = np.inf
+        out = set()
+        for a, b in associate(cost, self.assoc.gate_chi2, self.assoc.method):
+            self._tracks[idle[a]].update(z[b], standing[b].R, moving=False)
+            out.add(idle[a])
+        return out
+
+    def _initiate_standing(self, standing: list[PersonCandidate], stamp: float) -> None:
+        if not self.standing.params.enabled:
+            return
+        xy = np.array([(c.x, c.y) for c in standing]).reshape(-1, 2)
+        persistent = self.standing.persistent(xy)
+        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
+        for k in np.flatnonzero(persistent):
+            c = standing[k]
+            if len(known) and np.hypot(*(known - (c.x, c.y)).T).min() < self.assoc.spawn_exclusion_m:
+                continue
+            self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params, standing=True))
+            known = np.vstack([known, [c.x, c.y]])
+            self._next_id += 1
+
     def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float) -> None:
         known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
         fresh = [ci for ci in range(len(candidates)) if ci not in used]
@@ -226,6 +285,8 @@ class PeopleTracker:
         keep = []
         for t in self._tracks:
             if t.dead():
+                if t.furniture():
+                    self.standing.furniture(t.position)
                 if self.selector is not None and t.track_id == self.selector.target:
                     self.selector.lost(stamp, t.position)
                 continue

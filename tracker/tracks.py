@@ -73,7 +73,8 @@ class Track:
 class TrackState:
     """The mutable state of one track (internal to the tracker)."""
 
-    def __init__(self, track_id: int, x: float, y: float, R: np.ndarray, stamp: float, params: TrackParams) -> None:
+    def __init__(self, track_id: int, x: float, y: float, R: np.ndarray, stamp: float, params: TrackParams,
+                 standing: bool = False) -> None:
         self.track_id = track_id
         self.params = params
         kf = KalmanFilter(dim_x=4, dim_z=2)
@@ -88,7 +89,10 @@ class TrackState:
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
         self.hits: deque[bool] = deque([True], maxlen=params.confirm_window)
         self.origin = np.array([x, y])
-        self.confirmed = params.confirm_hits <= 1 and params.confirm_min_travel_m <= 0
+        # a standing person is confirmed by the persistence of their legs (see tracker.standing)
+        self.confirmed = standing or (params.confirm_hits <= 1 and params.confirm_min_travel_m <= 0)
+        self.born_standing = standing
+        self.moved = not standing  # has a moving candidate ever updated it
         self.updated_now = True
 
     @property
@@ -125,6 +129,7 @@ class TrackState:
         self.kf.update(z, R=R)
         self.last_update = self.stamp
         if moving:
+            self.moved = True
             self.last_moving_update = self.stamp
             self.moving_position = self.position.copy()
         self.updated_now = True
@@ -151,6 +156,15 @@ class TrackState:
         # largest eigenvalue of the 2x2 covariance [[a, b], [b, c]]
         largest = 0.5 * (a + c) + math.sqrt(0.25 * (a - c) ** 2 + b * b)
         return math.sqrt(max(largest, 0.0)) > p.max_position_std_m
+
+    @property
+    def held_still(self) -> bool:
+        """Kept in place by static evidence (standing, paused) since its last moving update."""
+        return not self.moved or self.last_update > self.last_moving_update
+
+    def furniture(self) -> bool:
+        """Born standing, never moved, and ended by ``max_static_s``: not a person."""
+        return self.born_standing and not self.moved and self.stamp - self.born > self.params.max_static_s
 
     def confidence(self) -> float:
         """Share of recent scans with an update, faded by the time since the last one."""

@@ -31,6 +31,17 @@ TRACKS = tracks_of([
 ])                                                                     # frame 4: person 1 missed
 
 
+def test_bearing_window_drops_people_and_tracks_outside_it_before_matching():
+    # person 2 at (3, 0) and person 3 at (0, 2) (bearing 90 deg); track 40 beside person 3
+    gt = gt_of([(0, 1, 1.0, 0.0), (0, 3, 0.0, 2.0), (1, 3, 0.0, 2.0)], n_frames=2)
+    tr = tracks_of([(0, 10, 1.0, 0.1), (0, 40, 0.1, 2.0), (1, 40, 0.1, 2.0), (1, 50, -2.0, -0.5)])
+    full = evaluate(gt, tr)
+    assert (full["ground_truth"], full["matches"], full["false_positives"]) == (3, 3, 1)
+    win = evaluate(gt, tr, bearing_window_deg=(-80.0, 12.0))
+    assert (win["ground_truth"], win["matches"], win["misses"], win["false_positives"]) == (1, 1, 0, 0)
+    assert win["frames"] == 2 and win["bearing_window_deg"] == [-80.0, 12.0]
+
+
 def test_hand_worked_case():
     r = evaluate(GT, TRACKS, "general", threshold=0.75, ospa_cutoff=1.0, ospa_order=1.0)
     assert r["frames"] == 5 and r["ground_truth"] == 8
@@ -90,6 +101,9 @@ def test_cli_scores_against_a_ground_truth_csv(tmp_path):
     proc = run_cli("evaluate", str(tmp_path / "t.csv"), "--ground-truth", str(tmp_path / "gt.csv"))
     assert proc.returncode == 0, proc.stderr
     assert "MOTA                 50.0 %" in proc.stdout and "MOTP                 0.200 m" in proc.stdout
+    proc = run_cli("evaluate", str(tmp_path / "t.csv"), "--ground-truth", str(tmp_path / "gt.csv"),
+                   "--bearing-window", "-80", "12")
+    assert proc.returncode == 0 and "bearing -80°..12° only" in proc.stdout, proc.stderr
 
 
 @pytest.mark.parametrize("tracks,args,words", [
@@ -99,6 +113,8 @@ def test_cli_scores_against_a_ground_truth_csv(tmp_path):
     ("scan_index,track_id,x,y\n0,1,a,2\n", [], "line 2"),
     ("scan_index,track_id,x,y\n0,1,1,2\n", ["--threshold", "-1"], "--threshold"),
     ("scan_index,track_id,x,y\n0,1,1,2\n", ["--protocol", "other"], "invalid choice"),
+    ("scan_index,track_id,x,y\n0,1,1,2\n", ["--bearing-window", "12", "-80"], "--bearing-window"),
+    ("scan_index,track_id,x,y\n0,1,1,2\n", ["--bearing-window", "-200", "12"], "--bearing-window"),
 ])
 def test_cli_bad_inputs(tmp_path, tracks, args, words):
     (tmp_path / "gt.csv").write_text("scan_index,person_id,x,y\n0,1,1.0,0.0\n")

@@ -6,7 +6,7 @@ from scipy.stats import chi2
 
 from models.scenario import build_simulation, load_scenario
 from models.scan import Scan
-from tracker.config import load_config
+from tracker.config import config_from_dict, load_config
 from tracker.evaluation import TrackRows, evaluate
 from tracker.io.ground_truth import GroundTruth
 from tracker.pairing import PairingParams, pair_legs
@@ -15,9 +15,10 @@ from tracker.tracks import TrackParams, TrackState
 from models.motion import constant_velocity_F, constant_velocity_Q
 
 
-def run_scene(name, follow=None, **overrides):
-    sim, n = build_simulation({**load_scenario(name), **overrides})
-    trk = PeopleTracker.from_config(load_config(), follow)
+def run_scene(name, follow=None, config=None, **overrides):
+    spec = name if isinstance(name, dict) else load_scenario(name)
+    sim, n = build_simulation({**spec, **overrides})
+    trk = PeopleTracker.from_config(config_from_dict(config), follow)
     rows, gt, targets = [], [], []
     for i in range(n):
         st = sim.step()
@@ -29,7 +30,7 @@ def run_scene(name, follow=None, **overrides):
                 targets.append((i, t.track_id))
         tr = st.truth
         gt += [(i, p, x, y) for p, (x, y) in zip(tr.person_id[tr.visible], tr.torso_sensor[tr.visible])]
-    g, r = np.array(gt), np.array(rows).reshape(-1, 4)
+    g, r = np.array(gt).reshape(-1, 4), np.array(rows).reshape(-1, 4)
     result = evaluate(GroundTruth(n, g[:, 0].astype(int), g[:, 1].astype(int), g[:, 2], g[:, 3]),
                       TrackRows(r[:, 0].astype(int), r[:, 1].astype(int), r[:, 2], r[:, 3]))
     return result, targets, trk
@@ -158,3 +159,42 @@ def test_legs_of_two_people_never_pair_across():
     assert pairs == [(1, 2), (3, 4)]
     # without the tracks, the nearest legs would pair across the two people
     assert (2, 3) in [c.object_ids for c in pair_legs(xy, sizes, [1, 2, 3, 4], p) if c.kind == "pair"]
+
+
+STILL = {"laser": {"fov_deg": 270, "resolution_deg": 0.35, "rate_hz": 10, "range_max": 20, "noise_std": 0.01},
+         "world": {"room": [-3, -8, 12, 8]}, "robot": {"start": [0, 0, 0]}, "seed": 3}
+
+
+def test_a_person_standing_still_is_found_by_leg_shape_and_kept_with_one_id():
+    """Standing for the whole 8 s: never seen moving, so motion alone never finds them."""
+    spec = {**STILL, "duration_s": 8, "people": [{"id": 1, "path": [[3, 0.5]]}]}
+    r, _, trk = run_scene(spec)
+    assert r["ground_truth"] == 80 and r["id_switches"] == 0 and r["false_positives"] == 0, r
+    assert r["misses"] <= 5 and r["motp_m"] < 0.15, r  # found within half a second
+    assert trk._next_id == 2
+    off, _, _ = run_scene(spec, config={"standing": {"enabled": False}})
+    assert off["matches"] == 0, off
+
+
+def test_a_pair_of_leg_like_posts_costs_one_short_track_and_is_remembered_as_furniture():
+    spec = {**STILL, "duration_s": 30, "people": [],
+            "world": {"room": [-3, -8, 12, 8], "pillars": [[3, -1, 0.05], [3, -0.7, 0.05]]}}
+    r, _, trk = run_scene(spec, config={"tracks": {"max_static_s": 5.0}})
+    assert r["false_positives"] <= 5.5 * 10, r  # one track, up to max_static_s, then never again
+    assert trk._next_id == 2
+    assert len(trk.standing._furniture) == 1
+
+
+def test_a_person_held_still_is_not_pulled_away_by_a_distant_moving_candidate():
+    params = TrackParams()
+    t = TrackState(1, 0.0, 0.0, np.eye(2) * 0.01, 0.0, params, standing=True)
+    assert t.confirmed and t.held_still
+    trk = PeopleTracker()
+    trk._tracks = [t]
+    for k in range(1, 8):  # coasting: its gate grows far beyond 1 m
+        t.predict(0.1 * k)
+    from tracker.pairing import PersonCandidate
+    far = PersonCandidate(1.2, 0.0, 0.1, "leg")
+    near = PersonCandidate(0.3, 0.0, 0.1, "leg")
+    assert trk._associate([far]) == []
+    assert trk._associate([near]) == [(0, 0)]

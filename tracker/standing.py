@@ -1,0 +1,112 @@
+"""Standing people: found by the shape of their legs, kept apart from furniture by persistence.
+
+Someone who stands still never moves, so motion detection (the paper's method) never
+reports them; on the annotated hallway recording most of the people are standing. Their
+legs still look like legs: two free-standing leg-shaped segments (see
+:func:`detection.legs.free_standing_legs`) a stance apart. Such a pair starts a track
+only when it comes back at the same place in the world in most of the last few scans (a
+one-off coincidence of two unrelated segments does not), never near an existing track,
+and never where a standing track was already ended as furniture: a standing track that
+has not moved after ``max_static_s`` (see :class:`~tracker.tracks.TrackParams`) is
+deleted and its place remembered, so a pair of table legs costs one short track, not one
+every few seconds.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from tracker.pairing import nearest_pairs
+
+
+@dataclass(frozen=True)
+class StandingParams:
+    """Attributes (metres, scans)
+    ----------
+    enabled : bool
+        Look for standing people at all.
+    min_points : int
+        Fewest readings of a leg.
+    max_leg_size_m : float
+        Longest chord of a standing leg, metres: narrower than a moving leg's limit, which
+        also covers a leg blurred by its own swing; at 30–40 cm above the floor a leg shows
+        5–15 cm, while furniture sides and boxes run longer.
+    edge_jump_m : float
+        A leg stands free: the beams beside it return nothing or something at least this
+        much farther, metres.
+    max_range_m : float
+        Legs farther than this have too few readings to judge, metres.
+    min_leg_separation_m, max_leg_separation_m : float
+        Distance between the two legs of a standing person, metres.
+    confirm_scans, confirm_window : int
+        A pair starts a track when pairs were found within ``confirm_radius_m`` of it in at
+        least ``confirm_scans`` of the last ``confirm_window`` scans (this one included).
+    confirm_radius_m : float
+        How far apart (world frame) the pairs of those scans may be, metres.
+    furniture_radius_m : float
+        No standing track starts this close to where one ended unmoved, metres.
+    """
+
+    enabled: bool = True
+    min_points: int = 3
+    max_leg_size_m: float = 0.18
+    edge_jump_m: float = 0.3
+    max_range_m: float = 6.0
+    min_leg_separation_m: float = 0.1
+    max_leg_separation_m: float = 0.5
+    confirm_scans: int = 3
+    confirm_window: int = 5
+    confirm_radius_m: float = 0.2
+    furniture_radius_m: float = 0.5
+
+
+def standing_pairs(legs_xy: np.ndarray, params: StandingParams) -> np.ndarray:
+    """Midpoints of the nearest disjoint leg pairs a stance apart, shape (k, 2), same frame."""
+    pairs = nearest_pairs(legs_xy, params.min_leg_separation_m, params.max_leg_separation_m)
+    if not pairs:
+        return np.zeros((0, 2))
+    i, j = np.array(pairs).T
+    return 0.5 * (legs_xy[i] + legs_xy[j])
+
+
+class StandingInitiator:
+    """Decides where standing people start: persistent pairs away from furniture.
+
+    Feed every scan's pairs (world frame) to :meth:`persistent`; tell it with
+    :meth:`furniture` where a standing track ended without moving.
+    """
+
+    def __init__(self, params: StandingParams, max_places: int = 1000) -> None:
+        self.params = params
+        self._recent: deque[np.ndarray] = deque(maxlen=params.confirm_window)
+        self._furniture: deque[np.ndarray] = deque(maxlen=max_places)
+
+    def persistent(self, pairs_world: np.ndarray) -> np.ndarray:
+        """Record this scan's pairs; return which of them persisted (bool, shape (k,))."""
+        self._recent.append(pairs_world)
+        p = self.params
+        seen = np.zeros(len(pairs_world), dtype=np.int64)
+        for earlier in self._recent:
+            if len(earlier) and len(pairs_world):
+                d = np.hypot(pairs_world[:, None, 0] - earlier[None, :, 0], pairs_world[:, None, 1] - earlier[None, :, 1])
+                seen += d.min(axis=1) <= p.confirm_radius_m
+        ok = seen >= p.confirm_scans
+        if ok.any() and self._furniture:
+            f = np.array(self._furniture)
+            d = np.hypot(pairs_world[:, None, 0] - f[None, :, 0], pairs_world[:, None, 1] - f[None, :, 1])
+            ok &= d.min(axis=1) > p.furniture_radius_m
+        return ok
+
+    def furniture(self, xy_world: np.ndarray) -> None:
+        """Remember a place (world frame, m) where a standing 'person' never moved."""
+        self._furniture.append(np.asarray(xy_world, dtype=float).copy())
+
+    def reset(self) -> None:
+        """Forget the recent pairs (a stamp jump, a new scanner); furniture stays."""
+        self._recent.clear()
+
+
+__all__ = ["StandingInitiator", "StandingParams", "standing_pairs"]
