@@ -171,6 +171,7 @@ class AlignmentConfig:
     max_rms_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     max_correction_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
     max_correction_rad: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3.15))
+    max_source_points: int = field(metadata=_spec(lo=0, hi=1000000))
 
     def params(self):
         from detection.align import AlignParams
