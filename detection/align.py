@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from detection.deskew import deskew, sweep_duration
 from detection.icp import IcpParams, MatchResult, ReferenceScan, match
@@ -51,12 +52,15 @@ class Alignment:
         The scan-to-scan match (None for the first scan or with matching disabled).
     prior : str
         ``odometry`` or ``prediction``.
+    tree : cKDTree or None
+        KD-tree of the de-skewed scan's valid readings (sensor frame), for the detector.
     """
 
     scan: Scan
     pose: Pose2D
     match: MatchResult | None
     prior: str
+    tree: cKDTree | None = None
 
 
 def _scale_motion(motion: Pose2D, fraction: float) -> Pose2D:
@@ -141,6 +145,7 @@ class ScanAligner:
             self._world = odom
         if dt is not None and dt > 0 and (result is None or result.ok or kind == "odometry"):
             self._velocity = (rel, dt)
-        self._ref = ReferenceScan(points, p.icp) if p.enabled else None
+        tree = cKDTree(points)
+        self._ref = ReferenceScan(points, p.icp, tree) if p.enabled else None
         self._prev_stamp, self._prev_odom = scan.stamp, odom
-        return Alignment(scan, self._world, result, kind)
+        return Alignment(scan, self._world, result, kind, tree)

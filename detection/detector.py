@@ -140,12 +140,14 @@ def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
     b_c = valid_c[~static_c]
     beam_all = bin_to_beams(pts_p, scan.angle_min, scan.angle_increment, scan.n_beams)
     # lines of sight the previous scan saw through (no return): free up to no_return_free_m
-    far = np.flatnonzero(prev.no_return) if params.no_return_free_m > 0 else np.zeros(0, dtype=np.int64)
-    a = prev.angles[far]
-    reach = min(prev.range_max, params.no_return_free_m)
-    pts_far = rel.transform_points(reach * np.column_stack([np.cos(a), np.sin(a)]))
-    beam_seen = np.concatenate([beam_all, bin_to_beams(pts_far, scan.angle_min, scan.angle_increment, scan.n_beams)])
-    r_seen = np.concatenate([r_p, np.hypot(pts_far[:, 0], pts_far[:, 1])])
+    beam_seen, r_seen = beam_all, r_p
+    far = np.flatnonzero(prev.no_return) if params.no_return_free_m > 0 else ()
+    if len(far):
+        a = prev.angles[far]
+        reach = min(prev.range_max, params.no_return_free_m)
+        pts_far = rel.transform_points(reach * np.column_stack([np.cos(a), np.sin(a)]))
+        beam_seen = np.concatenate([beam_all, bin_to_beams(pts_far, scan.angle_min, scan.angle_increment, scan.n_beams)])
+        r_seen = np.concatenate([r_p, np.hypot(pts_far[:, 0], pts_far[:, 1])])
     label_c, _ = scan_line_labels(b_c, scan.ranges[b_c], beam_all[~static_p], r_p[~static_p], scan.n_beams,
                                   params.scan_line_window, beam_seen, r_seen)
     labels[b_c] = label_c
@@ -257,7 +259,8 @@ class MovingObjectDetector:
                 chosen.append(past)
         return chosen
 
-    def detect(self, scan: Scan, pose: Pose2D | None = None, people: np.ndarray | None = None) -> Detection:
+    def detect(self, scan: Scan, pose: Pose2D | None = None, people: np.ndarray | None = None,
+               tree: cKDTree | None = None) -> Detection:
         """Labels and moving objects of ``scan``.
 
         Parameters
@@ -268,10 +271,12 @@ class MovingObjectDetector:
         people : ndarray, shape (k, 2), optional
             Tracked people in this scan's sensor frame, metres: the static-memory test
             leaves objects near them alone.
+        tree : cKDTree, optional
+            KD-tree of ``scan.valid_points`` when the caller has one (the aligner's).
         """
         p = self.params
         earlier = self._earlier(scan.stamp)
-        tree = _tree(scan)
+        tree = tree if tree is not None else _tree(scan)
         current = _Past(scan, pose, tree)
         self._history.append(current)
         while self._history and self._history[0].scan.stamp < scan.stamp - self._keep_s:

@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg.lapack import dsyev
 from scipy.spatial import cKDTree
 
 from models.pose import Pose2D, wrap_angle
@@ -122,14 +123,19 @@ def line_normals(points: np.ndarray, max_gap: float, half_width: int = 2) -> np.
 
 
 class ReferenceScan:
-    """A scan prepared as the target of matching: its points, KD-tree and normals (its own frame)."""
+    """A scan prepared as the target of matching (its own frame): its readings, their normals
+    (nan where a reading has none: an edge, a depth jump) and a KD-tree of all of them.
 
-    def __init__(self, points: np.ndarray, params: IcpParams) -> None:
-        normals = line_normals(points, params.normal_max_gap_m)
-        keep = np.isfinite(normals[:, 0])
-        self.points = points[keep]
-        self.normals = normals[keep]
-        self.tree = cKDTree(self.points) if len(self.points) else None
+    ``tree``, when given, is a KD-tree of ``points`` built elsewhere (the detector's own,
+    so it is built once a scan).
+    """
+
+    def __init__(self, points: np.ndarray, params: IcpParams, tree: cKDTree | None = None) -> None:
+        self.points = points
+        self.normals = line_normals(points, params.normal_max_gap_m)
+        self.usable = np.isfinite(self.normals[:, 0])
+        self.n_usable = int(self.usable.sum())
+        self.tree = (tree if tree is not None else cKDTree(points)) if self.n_usable else None
 
 
 def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: IcpParams,
@@ -161,7 +167,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
     def fail(reason: str, rms=math.nan, overlap=0.0, cond=0.0, it=0) -> MatchResult:
         return MatchResult(prior, False, rms, overlap, cond, False, it, reason)
 
-    if reference.tree is None or len(reference.points) < params.min_pairs or n_src < params.min_pairs:
+    if reference.tree is None or reference.n_usable < params.min_pairs or n_src < params.min_pairs:
         return fail("too few readings")
     x, y, th = prior.x, prior.y, prior.yaw
     gate = params.max_correspondence_m
@@ -175,6 +181,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         p = src @ np.array([[c, s], [-s, c]]) + (x, y)  # R p + t, in the reference frame
         dist, j = reference.tree.query(p, k=1, distance_upper_bound=gate)
         found = np.isfinite(dist)
+        found[found] = reference.usable[j[found]]  # a partner without a normal gives no line
         if found.sum() < params.min_pairs:
             return fail("too few correspondences", it=it)
         p, q, nq = p[found], reference.points[j[found]], reference.normals[j[found]]
@@ -194,7 +201,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         scale = max(math.sqrt(float(np.einsum("ij,ij->", p, p)) / len(p)), 1.0)
         d = np.array([1.0, 1.0, 1.0 / scale])
         D = np.diag(d)
-        w, V = np.linalg.eigh(Hm * np.outer(d, d))  # D H D
+        w, V, _ = dsyev(Hm * np.outer(d, d))  # eigen-decomposition of D H D (LAPACK, no wrapper)
         cond = float(w[0] / w[-1]) if w[-1] > 0 else 0.0
         # solve in the scaled space, dropping directions the scene does not constrain
         good = w > params.degeneracy_ratio * w[-1]
@@ -208,7 +215,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         rms = math.sqrt(float(r @ r) / len(r))
         overlap = float(keep.sum() / n_src)
         gate = max(params.min_correspondence_m, gate * 0.5)
-        if it >= 2 and abs(dx) < 1e-3 and abs(dy) < 1e-3 and abs(dth) < 1e-4:
+        if it >= 2 and abs(dx) < 2e-3 and abs(dy) < 2e-3 and abs(dth) < 2e-4:
             break  # settled: a further step would move a reading less than 1 mm (at 10 m)
     result = Pose2D(x, y, th)
     correction = prior.between(result)

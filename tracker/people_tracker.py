@@ -131,7 +131,8 @@ class PeopleTracker:
         aligned = self.aligner.align(scan, pose, pose_last_beam, people)  # 0. de-skew and align
         scan, world = aligned.scan, aligned.pose
         # 1. moving objects (sensor frame)
-        detection = self.detector.detect(scan, world, world.inverse().transform_points(people) if len(people) else None)
+        detection = self.detector.detect(scan, world, world.inverse().transform_points(people) if len(people) else None,
+                                         aligned.tree)
         for t in self._tracks:  # 2. predict every track to the scan time
             t.predict(scan.stamp)
         candidates = self._candidates(detection, world)  # 3. legs paired into people (world frame)
