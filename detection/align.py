@@ -17,7 +17,7 @@ from scipy.spatial import cKDTree
 
 from detection.deskew import deskew, sweep_duration
 from detection.icp import IcpParams, MatchResult, ReferenceScan, match
-from models.pose import Pose2D, interpolate_pose
+from models.pose import Pose2D, interpolate_pose, pairwise_distances
 from models.scan import Scan
 
 
@@ -87,7 +87,7 @@ class ScanAligner:
         if people_world is None or not len(people_world) or not len(points):
             return None
         local = (self._world @ rel).inverse().transform_points(np.asarray(people_world, dtype=float))
-        d = np.hypot(points[:, None, 0] - local[None, :, 0], points[:, None, 1] - local[None, :, 1])
+        d = pairwise_distances(points, local)
         return d.min(axis=1) < self.params.exclude_radius_m
 
     def align(self, scan: Scan, odom: Pose2D | None = None, odom_last_beam: Pose2D | None = None,

@@ -20,7 +20,7 @@ from detection.recover import isolated_occluded, recover_moving
 from detection.scan_lines import bin_to_beams, scan_line_labels
 from detection.segments import split_runs
 from detection.thresholds import range_threshold
-from models.pose import Pose2D
+from models.pose import Pose2D, pairwise_distances
 from models.scan import Scan
 
 
@@ -227,7 +227,7 @@ class MovingObjectDetector:
         test = np.arange(len(spans))
         if people is not None and len(people):
             xy = np.array([pts[a:b].mean(axis=0) for a, b in spans])
-            d = np.hypot(xy[:, None, 0] - people[None, :, 0], xy[:, None, 1] - people[None, :, 1]).min(axis=1)
+            d = pairwise_distances(xy, people).min(axis=1)
             test = test[d > p.static_memory_keep_m]
         if not len(test):
             return keep

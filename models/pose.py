@@ -86,3 +86,9 @@ def interpolate_pose(p0: Pose2D, p1: Pose2D, fraction: float) -> Pose2D:
         p0.y + fraction * (p1.y - p0.y),
         float(wrap_angle(p0.yaw + fraction * dyaw)),
     )
+
+
+def pairwise_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Euclidean distance of every point of ``a`` (shape (n, 2)) to every point of ``b``
+    (shape (m, 2)), both in one frame, metres; shape (n, m)."""
+    return np.hypot(a[:, None, 0] - b[None, :, 0], a[:, None, 1] - b[None, :, 1])

@@ -26,6 +26,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from models.pose import pairwise_distances
 from tracker.io.ground_truth import GroundTruth
 
 
@@ -57,7 +58,7 @@ def ospa(gt_xy: np.ndarray, tr_xy: np.ndarray, cutoff: float, order: float) -> f
         return 0.0
     if m == 0 or n == 0:
         return cutoff
-    d = np.minimum(np.hypot(gt_xy[:, None, 0] - tr_xy[None, :, 0], gt_xy[:, None, 1] - tr_xy[None, :, 1]), cutoff)
+    d = np.minimum(pairwise_distances(gt_xy, tr_xy), cutoff)
     cost = d ** order
     rows, cols = linear_sum_assignment(cost)
     # (1/n (Σ d_c^p over the assignment + c^p |m - n|))^(1/p)
@@ -111,7 +112,7 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
         gxy = np.column_stack([gt.x[g], gt.y[g]])
         txy = np.column_stack([tracks.x[t], tracks.y[t]])
         # Euclidean distances (not squared: MOTP is then in metres); beyond the threshold: no match
-        d = np.hypot(gxy[:, None, 0] - txy[None, :, 0], gxy[:, None, 1] - txy[None, :, 1]) if len(g) and len(t) \
+        d = pairwise_distances(gxy, txy) if len(g) and len(t) \
             else np.zeros((len(g), len(t)))
         d[d > threshold] = np.nan
         acc.update(gt.person_id[g].tolist(), tracks.track_id[t].tolist(), d)

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from models.pose import pairwise_distances
+
 
 @dataclass(frozen=True)
 class PairingParams:
@@ -75,7 +77,7 @@ def owners(xy: np.ndarray, predictions: np.ndarray, radius: float) -> np.ndarray
     """For each object, the index of the nearest predicted person within ``radius`` metres, else -1."""
     if len(xy) == 0 or len(predictions) == 0:
         return np.full(len(xy), -1, dtype=np.int64)
-    d = np.hypot(xy[:, None, 0] - predictions[None, :, 0], xy[:, None, 1] - predictions[None, :, 1])
+    d = pairwise_distances(xy, predictions)
     nearest = d.argmin(axis=1)
     return np.where(d[np.arange(len(xy)), nearest] <= radius, nearest, -1)
 
@@ -95,7 +97,7 @@ def nearest_pairs(xy: np.ndarray, min_separation_m: float, max_separation_m: flo
     """
     if len(xy) < 2:
         return []
-    d = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
+    d = pairwise_distances(xy, xy)
     a, b = np.triu_indices(len(xy), k=1)
     ok = (d[a, b] >= min_separation_m) & (d[a, b] <= max_separation_m)
     if allowed is not None:

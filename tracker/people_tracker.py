@@ -17,7 +17,7 @@ from detection.align import Alignment, AlignParams, ScanAligner
 from detection.detector import Detection, DetectorParams, MovingObjectDetector
 from detection.free_space import seen_through
 from detection.legs import free_standing_legs
-from models.pose import Pose2D
+from models.pose import Pose2D, pairwise_distances
 from models.scan import Scan
 from tracker.association import associate, mahalanobis_costs
 from tracker.following import TargetSelector
@@ -177,7 +177,7 @@ class PeopleTracker:
         still = np.array([t.held_still for t in self._tracks])
         if still.any():
             anchors = np.array([t.moving_position for t in self._tracks])
-            away = np.hypot(anchors[:, None, 0] - z[None, :, 0], anchors[:, None, 1] - z[None, :, 1]) > self.assoc.recover_radius_m
+            away = pairwise_distances(anchors, z) > self.assoc.recover_radius_m
             cost[still[:, None] & away] = np.inf
         # confirmed tracks choose first: a tentative track never takes a confirmed one's candidate
         confirmed = np.array([t.confirmed for t in self._tracks])
@@ -197,7 +197,7 @@ class PeopleTracker:
             return []
         anchors = np.array([self._tracks[i].moving_position for i in idle])
         z = np.array([(candidates[k].x, candidates[k].y) for k in free])
-        d = np.hypot(anchors[:, None, 0] - z[None, :, 0], anchors[:, None, 1] - z[None, :, 1])
+        d = pairwise_distances(anchors, z)
         pairs = associate(d, self.assoc.recover_radius_m, "gnn")
         for a, _ in pairs:
             self._tracks[idle[a]].forget_velocity()
@@ -239,7 +239,7 @@ class PeopleTracker:
         cost = mahalanobis_costs(means, covs, z, np.array([c.R for c in standing]))
         # like static support, a pair must lie near where the track last moved (or was born standing)
         anchors = np.array([self._tracks[i].moving_position for i in idle])
-        far = np.hypot(anchors[:, None, 0] - z[None, :, 0], anchors[:, None, 1] - z[None, :, 1]) > self.assoc.support_anchor_m
+        far = pairwise_distances(anchors, z) > self.assoc.support_anchor_m
         cost[far] = np.inf
         out = set()
         for a, b in associate(cost, self.assoc.gate_chi2, self.assoc.method):
@@ -252,17 +252,19 @@ class PeopleTracker:
             return
         xy = np.array([(c.x, c.y) for c in standing]).reshape(-1, 2)
         persistent = self.standing.persistent(xy)
+        self._spawn([standing[k] for k in np.flatnonzero(persistent)], stamp, standing=True)
+
+    def _spawn(self, candidates: list[PersonCandidate], stamp: float, standing: bool = False) -> None:
+        """A new track for each candidate not within the spawn exclusion of any track."""
         known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
-        for k in np.flatnonzero(persistent):
-            c = standing[k]
+        for c in candidates:
             if len(known) and np.hypot(*(known - (c.x, c.y)).T).min() < self.assoc.spawn_exclusion_m:
                 continue
-            self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params, standing=True))
+            self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params, standing))
             known = np.vstack([known, [c.x, c.y]])
             self._next_id += 1
 
     def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float) -> None:
-        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
         fresh = [ci for ci in range(len(candidates)) if ci not in used]
         free = np.ones(len(candidates), dtype=bool)
         if fresh and self.assoc.free_space_lookback_s > 0:
@@ -273,14 +275,7 @@ class PeopleTracker:
                 seen |= seen_through(xy, scan, pose, self.assoc.free_space_margin_m, moving,
                                      self.detector.params.no_return_free_m)
             free[fresh] = seen
-        for ci, c in enumerate(candidates):
-            if ci in used or not free[ci]:
-                continue
-            if len(known) and np.hypot(*(known - (c.x, c.y)).T).min() < self.assoc.spawn_exclusion_m:
-                continue
-            self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params))
-            known = np.vstack([known, [c.x, c.y]])
-            self._next_id += 1
+        self._spawn([c for ci, c in enumerate(candidates) if ci not in used and free[ci]], stamp)
 
     def _delete(self, stamp: float) -> None:
         keep = []

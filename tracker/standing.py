@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from models.pose import pairwise_distances
 from tracker.pairing import nearest_pairs
 
 
@@ -91,12 +92,12 @@ class StandingInitiator:
         seen = np.zeros(len(pairs_world), dtype=np.int64)
         for earlier in self._recent:
             if len(earlier) and len(pairs_world):
-                d = np.hypot(pairs_world[:, None, 0] - earlier[None, :, 0], pairs_world[:, None, 1] - earlier[None, :, 1])
+                d = pairwise_distances(pairs_world, earlier)
                 seen += d.min(axis=1) <= p.confirm_radius_m
         ok = seen >= p.confirm_scans
         if ok.any() and self._furniture:
             f = np.array(self._furniture)
-            d = np.hypot(pairs_world[:, None, 0] - f[None, :, 0], pairs_world[:, None, 1] - f[None, :, 1])
+            d = pairwise_distances(pairs_world, f)
             ok &= d.min(axis=1) > p.furniture_radius_m
         return ok
 

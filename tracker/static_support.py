@@ -15,7 +15,7 @@ import numpy as np
 
 from detection.segments import split_runs
 from detection.thresholds import range_threshold
-from models.pose import Pose2D
+from models.pose import Pose2D, pairwise_distances
 from models.scan import Scan
 
 
@@ -50,7 +50,7 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
     for i, r in enumerate(runs):
         seg_of[r.start:r.stop] = i
     pred_sensor = pose.inverse().transform_points(predictions_world)
-    d = np.hypot(pts[None, :, 0] - pred_sensor[:, None, 0], pts[None, :, 1] - pred_sensor[:, None, 1])
+    d = pairwise_distances(pred_sensor, pts)
     chosen = np.zeros(len(runs), dtype=bool)
     for t in range(len(pred_sensor)):
         near = seg_of[d[t] <= radius_m]
