@@ -75,6 +75,7 @@ class StepResult:
     pose: Pose2D
     scan: Scan  # as the detector saw it (de-skewed)
     alignment: Alignment
+    standing: list[PersonCandidate] = ()  # leg pairs found by shape (world frame)
 
 
 class PeopleTracker:
@@ -151,7 +152,7 @@ class PeopleTracker:
         self._delete(scan.stamp)  # 9. delete what the lifecycle rules end
         target = self._follow(world, scan.stamp)  # 10. the followed person
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.confirmed]
-        self.last = StepResult(reported, detection, candidates, world, scan, aligned)
+        self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing)
         return reported
 
     def _candidates(self, detection: Detection, world: Pose2D) -> list[PersonCandidate]:

@@ -6,7 +6,8 @@ Entities (all in the world frame, metres; timelines ``scan`` (index) and ``stamp
   O occluded orange, N out of view blue);
 * ``world/objects/hulls`` and ``world/objects/boxes``: moving objects' convex hulls and
   minimum rotated rectangles;
-* ``world/candidates``: person candidates (pairs green, single legs yellow, blobs cyan);
+* ``world/candidates``: person candidates (pairs green, single legs yellow, blobs cyan;
+  leg pairs found by shape, standing people, magenta);
 * ``world/tracks`` (positions with their ids), ``world/tracks/trails``,
   ``world/tracks/covariance`` (2σ ellipses); the followed person larger;
 * ``world/robot`` (the sensor's pose as an arrow) and ``world/robot/path``;
@@ -36,7 +37,8 @@ from tracker.sinks import Sink
 
 _SET_COLOURS = [(STATIC, "A static", (150, 150, 150)), (MOVING, "M moving", (230, 40, 40)),
                 (OCCLUDED, "O occluded", (255, 160, 0)), (OUT_OF_VIEW, "N out of view", (60, 110, 255))]
-_CANDIDATE_COLOURS = {"pair": (40, 200, 80), "leg": (230, 210, 40), "blob": (40, 200, 220)}
+_CANDIDATE_COLOURS = {"pair": (40, 200, 80), "leg": (230, 210, 40), "blob": (40, 200, 220),
+                      "standing": (220, 60, 220)}
 _TRAIL = 40  # scans of trail per track
 
 
@@ -120,7 +122,7 @@ class RerunSink(Sink):
                     out.append(np.asarray(geom.coords))
         rec.log("world/objects/hulls", rr.LineStrips2D(hulls, colors=(230, 40, 40), radii=0.01))
         rec.log("world/objects/boxes", rr.LineStrips2D(boxes, colors=(255, 120, 120), radii=0.005))
-        cands = result.candidates
+        cands = list(result.candidates) + list(result.standing)
         rec.log("world/candidates", rr.Points2D([(c.x, c.y) for c in cands],
                                                 colors=[_CANDIDATE_COLOURS.get(c.kind, (255, 255, 255)) for c in cands],
                                                 radii=0.06))
