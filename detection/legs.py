@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from detection.segments import run_bounds
 from detection.thresholds import range_threshold
 from models.scan import Scan
 
@@ -43,12 +44,9 @@ def free_standing_legs(scan: Scan, k_segment: float, segment_floor_m: float, min
         return np.zeros((0, 2))
     pts = scan.points[valid]
     r = scan.ranges[valid]
-    gap = range_threshold(r, scan.resolution, k_segment, segment_floor_m)
-    spacing = np.hypot(*np.diff(pts, axis=0).T)
     # segments: runs of valid readings closer than the threshold, in beam order
-    cut = np.flatnonzero(spacing >= gap[:-1]) + 1
-    start = np.concatenate([[0], cut])
-    stop = np.concatenate([cut, [len(valid)]])
+    bounds = run_bounds(pts, range_threshold(r, scan.resolution, k_segment, segment_floor_m))
+    start, stop = bounds[:-1], bounds[1:]
     count = stop - start
     chord = np.hypot(*(pts[stop - 1] - pts[start]).T)
     nearest = np.minimum.reduceat(r, start)

@@ -37,10 +37,20 @@ def split_runs(labels: np.ndarray, points: np.ndarray, gap_threshold: np.ndarray
     gap_threshold : ndarray, shape (n,)
         Largest spacing (m) from each reading to the next one within a segment.
     """
-    n = len(labels)
-    if n == 0:
+    if len(labels) == 0:
         return []
-    gap = np.hypot(*np.diff(points, axis=0).T)
-    cut = (labels[1:] != labels[:-1]) | (gap >= gap_threshold[:-1])
-    bounds = np.concatenate([[0], np.flatnonzero(cut) + 1, [n]])
+    bounds = run_bounds(points, gap_threshold, labels)
     return [Segment(int(a), int(b), int(labels[a]), (int(labels[a]),)) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def run_bounds(points: np.ndarray, gap_threshold: np.ndarray, labels: np.ndarray | None = None) -> np.ndarray:
+    """Boundaries of the runs of :func:`split_runs`: run k is ``bounds[k]:bounds[k + 1]``.
+
+    Parameters are those of :func:`split_runs`; without ``labels`` only gaps split.
+    Returns an int array of shape (runs + 1,), starting at 0 and ending at ``len(points)``.
+    """
+    n = len(points)
+    cut = np.hypot(*np.diff(points, axis=0).T) >= gap_threshold[:-1]
+    if labels is not None:
+        cut |= labels[1:] != labels[:-1]
+    return np.concatenate([[0], np.flatnonzero(cut) + 1, [n]])
