@@ -4,15 +4,15 @@ A scanner sweeps its beams over tens of milliseconds (``time_increment`` apart);
 driving at 1.2 m/s moves 6 cm meanwhile, as much as the motion the detector looks for.
 With the sensor pose at the first and at the last beam (odometry), each reading is moved
 into the sensor frame at the scan stamp (the first beam's time) and the scan is resampled
-onto its own beam grid, so every later stage still gets an ordinary :class:`Scan`.
+onto a beam grid of its own, so every later stage still gets an ordinary :class:`Scan`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from models.pose import Pose2D, wrap_angle
-from models.scan import Scan
+from models.pose import Pose2D
+from models.scan import Scan, beam_index
 
 
 def sweep_duration(scan: Scan) -> float:
@@ -33,32 +33,61 @@ def deskew(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> Scan:
     Returns
     -------
     Scan
-        Same beam grid, stamp and limits. Each reading goes to the beam nearest its new
-        bearing (the nearest reading wins where two meet); a beam that saw nothing
-        (``inf``, see :attr:`Scan.no_return`) stays ``inf`` unless a reading lands on it; any
-        other beam left without one is ``nan``.
+        Same beam count, ``angle_min``, stamp and limits; see :func:`deskew_with_source`.
+    """
+    return deskew_with_source(scan, pose_first, pose_last)[0]
+
+
+def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tuple[Scan, np.ndarray]:
+    """:func:`deskew`, and which raw beam each de-skewed beam's reading came from.
+
+    The sweep's rotation turns every line of sight by an amount that grows linearly with
+    the beam index, so it goes into the output grid itself: its increment is the raw one
+    plus the rotation per beam (a sensor turning against its sweep direction packs its
+    beams closer). A sweep that only turns then moves no reading off its beam and loses
+    none. The translation moves each reading's bearing by an amount that depends on its
+    range; each goes to the beam nearest its new bearing (:func:`models.scan.beam_index`),
+    the nearest reading wins where two meet (the other is hidden from the first pose),
+    and readings that leave the field of view are dropped. Each keeps its exact bearing
+    (:attr:`Scan.bearings`), so the scan's points are where the first pose would have seen
+    them, not moved to the grid.
+
+    Returns
+    -------
+    scan : Scan
+        A beam that saw nothing (``inf``, see :attr:`Scan.no_return`) stays ``inf`` unless a
+        reading lands on it; any other beam left without a reading is ``nan``.
+    source : ndarray of int64, shape (n_beams,)
+        Raw beam index of the reading each de-skewed beam holds, -1 for none.
     """
     motion = pose_first.between(pose_last)  # the sweep's motion, in the first beam's frame
-    if scan.n_beams < 2 or (abs(motion.x) < 1e-6 and abs(motion.y) < 1e-6 and abs(motion.yaw) < 1e-7):
-        return scan
     n = scan.n_beams
+    if n < 2 or (abs(motion.x) < 1e-6 and abs(motion.y) < 1e-6 and abs(motion.yaw) < 1e-7):
+        return scan, np.where(scan.valid, np.arange(n), -1)
+    # the sweep's rotation, spread over its beams, goes into the grid (unless it would fold it)
+    increment = scan.angle_increment + motion.yaw / (n - 1)
+    if increment * scan.angle_increment <= 0 or abs(increment) < 0.5 * abs(scan.angle_increment):
+        increment = scan.angle_increment
     frac = np.arange(n) / (n - 1)
     # per-beam sensor pose relative to the first beam: linear in translation and heading
     yaw = frac * motion.yaw
     tx, ty = frac * motion.x, frac * motion.y
-    valid = scan.valid
+    valid = np.flatnonzero(scan.valid)
     r = scan.ranges[valid]
     a = scan.angles[valid] + yaw[valid]
+    # p' = t_i + R(yaw_i) p_i
     x = tx[valid] + r * np.cos(a)
     y = ty[valid] + r * np.sin(a)
     new_r = np.hypot(x, y)
     bearing = np.arctan2(y, x)
-    idx = np.rint(wrap_angle(bearing - scan.angle_min) / scan.angle_increment).astype(np.int64)
-    if scan.angle_increment < 0:
-        idx = np.rint(-wrap_angle(scan.angle_min - bearing) / abs(scan.angle_increment)).astype(np.int64)
-    keep = (idx >= 0) & (idx < n) & (new_r > scan.range_min) & (new_r < scan.range_max)
+    idx = beam_index(bearing, scan.angle_min, increment, n)
+    keep = (idx >= 0) & (new_r > scan.range_min) & (new_r < scan.range_max)
     out = np.where(scan.no_return, np.inf, np.nan)  # the sweep moves a line of sight by under a beam
-    order = np.argsort(-new_r[keep])  # farthest first, so the nearest reading in a beam is written last
+    source = np.full(n, -1, dtype=np.int64)
+    order = np.argsort(-new_r[keep], kind="stable")  # farthest first: the nearest in a beam is written last
     out[idx[keep][order]] = new_r[keep][order]
-    return Scan(out, scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max, scan.stamp,
-                scan.frame_id, scan.time_increment)
+    source[idx[keep][order]] = valid[keep][order]
+    bearings = scan.angle_min + np.arange(n) * increment  # the grid, and each reading's own bearing
+    bearings[idx[keep][order]] = bearing[keep][order]
+    return Scan(out, scan.angle_min, increment, scan.range_min, scan.range_max, scan.stamp,
+                scan.frame_id, scan.time_increment, bearings), source

@@ -14,33 +14,31 @@ def join(runs: list[Segment], into: int, source: int, points: np.ndarray, join_t
     whose nearer end lies within the join threshold of its own end.
 
     The absorbed segment leaves ``source``, so it joins one object at most. Repeats until
-    nothing changes. A join that would make the object longer than ``max_extent`` metres
-    (end to end) is refused. ``runs`` is edited in place; returns whether anything joined.
+    nothing changes, the closest pair of ends first (so the result does not depend on
+    which way the scanner counts its beams). The threshold of a pair of ends is the larger
+    of theirs. A join that would make the object longer than ``max_extent`` metres (end to
+    end) is refused. ``runs`` is edited in place; returns whether anything joined.
     """
     joined_any = False
-    changed = True
-    while changed:
-        changed = False
-        for i, seg in enumerate(runs):
-            if seg.label != into:
+    while True:
+        best, best_gap = -1, np.inf
+        for i in range(len(runs) - 1):
+            a, b = runs[i], runs[i + 1]  # a precedes b in beam order
+            if {a.label, b.label} != {into, source}:
                 continue
-            for j in (i - 1, i + 1):
-                if not 0 <= j < len(runs) or runs[j].label != source:
-                    continue
-                other = runs[j]
-                a, b = (seg, other) if j > i else (other, seg)  # a precedes b in beam order
-                if np.hypot(*(points[b.start] - points[a.stop - 1])) >= join_threshold[a.stop - 1]:
-                    continue
-                if np.hypot(*(points[b.stop - 1] - points[a.start])) > max_extent:
-                    continue
-                merged = Segment(a.start, b.stop, into, tuple(sorted(set(seg.sets) | {source})))
-                runs[min(i, j)] = merged
-                del runs[max(i, j)]
-                changed = joined_any = True
-                break
-            if changed:
-                break
-    return joined_any
+            gap = np.hypot(*(points[b.start] - points[a.stop - 1]))
+            if gap >= max(join_threshold[a.stop - 1], join_threshold[b.start]) or gap >= best_gap:
+                continue
+            if np.hypot(*(points[b.stop - 1] - points[a.start])) > max_extent:
+                continue
+            best, best_gap = i, gap
+        if best < 0:
+            return joined_any
+        a, b = runs[best], runs[best + 1]
+        seg = a if a.label == into else b
+        runs[best] = Segment(a.start, b.stop, into, tuple(sorted(set(seg.sets) | {source})))
+        del runs[best + 1]
+        joined_any = True
 
 
 def isolated_occluded(runs: list[Segment], points: np.ndarray, ranges: np.ndarray, gap: np.ndarray,

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW
+from models.scan import beam_index
 
 
 def bin_to_beams(points: np.ndarray, angle_min: float, angle_increment: float, n_beams: int) -> np.ndarray:
@@ -16,13 +17,7 @@ def bin_to_beams(points: np.ndarray, angle_min: float, angle_increment: float, n
     points : ndarray, shape (m, 2)
         Points in the current sensor frame, metres.
     """
-    bearing = np.arctan2(points[:, 1], points[:, 0])
-    # the offset from beam 0 in the scan's own direction, wrapped to one turn
-    offset = (bearing - angle_min) * np.sign(angle_increment)
-    offset = np.mod(offset + np.pi / 8, 2 * np.pi) - np.pi / 8  # a little before beam 0 stays negative
-    idx = np.rint(offset / abs(angle_increment)).astype(np.int64)
-    idx[(idx < 0) | (idx >= n_beams)] = -1
-    return idx
+    return beam_index(np.arctan2(points[:, 1], points[:, 0]), angle_min, angle_increment, n_beams)
 
 
 def _nearest_per_beam(beam: np.ndarray, rng: np.ndarray, n_beams: int) -> np.ndarray:
@@ -35,17 +30,26 @@ def _nearest_per_beam(beam: np.ndarray, rng: np.ndarray, n_beams: int) -> np.nda
     return at_beam
 
 
-def _partner(beam_c: np.ndarray, at_beam: np.ndarray, window: int) -> np.ndarray:
-    """For each current beam, the reading on its line of sight, else the nearest within ``window`` beams."""
+def _partner(beam_c: np.ndarray, at_beam: np.ndarray, rng: np.ndarray, window: int) -> np.ndarray:
+    """For each current beam, the reading on its line of sight, else the nearest within ``window`` beams.
+
+    Of the two readings equally many beams away on either side, the one nearer the sensor
+    (``rng``, metres) is taken: what the widened line of sight meets first, as within one
+    beam. So the choice is the same whichever way the scanner counts its beams.
+    """
     n_beams = len(at_beam)
     partner = at_beam[beam_c]
+    if not len(rng):
+        return partner
     for step in range(1, window + 1):
-        for sign in (-1, 1):
-            need = partner < 0
-            if not need.any():
-                return partner
-            j = np.minimum(np.maximum(beam_c[need] + sign * step, 0), n_beams - 1)
-            partner[need] = at_beam[j]
+        need = np.flatnonzero(partner < 0)
+        if not len(need):
+            break
+        lo = at_beam[np.maximum(beam_c[need] - step, 0)]
+        hi = at_beam[np.minimum(beam_c[need] + step, n_beams - 1)]
+        r_lo = np.where(lo >= 0, rng[np.maximum(lo, 0)], np.inf)
+        r_hi = np.where(hi >= 0, rng[np.maximum(hi, 0)], np.inf)
+        partner[need] = np.where(r_hi < r_lo, hi, lo)
     return partner
 
 
@@ -87,10 +91,10 @@ def scan_line_labels(beam_c: np.ndarray, range_c: np.ndarray, beam_p: np.ndarray
     label_p = np.full(len(beam_p), OUT_OF_VIEW, dtype=np.int8)
     if len(beam_c) == 0:
         return label_c, label_p
-    partner = _partner(beam_c, _nearest_per_beam(beam_p, range_p, n_beams), window)
+    partner = _partner(beam_c, _nearest_per_beam(beam_p, range_p, n_beams), range_p, window)
     has = partner >= 0
     if beam_all is not None:
-        fallback = _partner(beam_c[~has], _nearest_per_beam(beam_all, range_all, n_beams), window)
+        fallback = _partner(beam_c[~has], _nearest_per_beam(beam_all, range_all, n_beams), range_all, window)
         seen = fallback >= 0
         idx = np.flatnonzero(~has)[seen]
         ahead = range_c[idx] < range_all[fallback[seen]]

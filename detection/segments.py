@@ -35,7 +35,8 @@ def split_runs(labels: np.ndarray, points: np.ndarray, gap_threshold: np.ndarray
     points : ndarray, shape (n, 2)
         The readings, metres.
     gap_threshold : ndarray, shape (n,)
-        Largest spacing (m) from each reading to the next one within a segment.
+        Largest spacing (m) of each reading from its neighbours within a segment; two
+        consecutive readings are judged by the larger of their thresholds.
     """
     if len(labels) == 0:
         return []
@@ -50,7 +51,7 @@ def run_bounds(points: np.ndarray, gap_threshold: np.ndarray, labels: np.ndarray
     Returns an int array of shape (runs + 1,), starting at 0 and ending at ``len(points)``.
     """
     n = len(points)
-    cut = np.hypot(*np.diff(points, axis=0).T) >= gap_threshold[:-1]
+    cut = np.hypot(*np.diff(points, axis=0).T) >= np.maximum(gap_threshold[:-1], gap_threshold[1:])
     if labels is not None:
         cut |= labels[1:] != labels[:-1]
     return np.concatenate([[0], np.flatnonzero(cut) + 1, [n]])

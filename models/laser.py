@@ -54,7 +54,14 @@ class LaserModel:
     sweep_fraction: float = 0.75
 
     @property
+    def full_turn(self) -> bool:
+        """The beams go all the way round: the last one is the first one's neighbour."""
+        return self.fov >= 2.0 * math.pi - 1e-9
+
+    @property
     def n_beams(self) -> int:
+        if self.full_turn:
+            return int(round(2.0 * math.pi / self.resolution))
         return int(round(self.fov / self.resolution)) + 1
 
     @property
@@ -64,7 +71,7 @@ class LaserModel:
 
     @property
     def angle_increment(self) -> float:
-        step = self.fov / (self.n_beams - 1)
+        step = 2.0 * math.pi / self.n_beams if self.full_turn else self.fov / (self.n_beams - 1)
         return -step if self.clockwise else step
 
     @property

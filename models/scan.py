@@ -7,6 +7,42 @@ from functools import cached_property
 
 import numpy as np
 
+TWO_PI = 2.0 * np.pi
+
+
+def beam_index(bearing, angle_min: float, angle_increment: float, n_beams: int) -> np.ndarray:
+    """Index of the beam whose line of sight lies nearest each bearing; -1 outside the view.
+
+    The one place that turns a bearing into a beam: it follows the scan's direction (a
+    negative ``angle_increment`` counts clockwise) and works for any field of view up to a
+    full turn, where the last beam and the first are neighbours.
+
+    Parameters
+    ----------
+    bearing : array_like of float, shape (m,)
+        Bearings in the sensor frame, radians, any branch (they are wrapped here).
+    angle_min, angle_increment : float
+        Bearing of beam 0 and the step between beams, radians.
+    n_beams : int
+
+    Returns
+    -------
+    ndarray of int64, shape (m,)
+        Beam index in ``0 .. n_beams-1``, or -1 for a bearing more than half a beam outside
+        the field of view.
+    """
+    res = abs(angle_increment)
+    # the offset from beam 0 in the scan's own direction, wrapped to the one turn centred on
+    # the middle of the view, so the blind sector behind splits evenly between the two ends
+    centre = 0.5 * (n_beams - 1) * res
+    offset = (np.asarray(bearing, dtype=np.float64) - angle_min) * np.sign(angle_increment)
+    offset = np.mod(offset - centre + np.pi, TWO_PI) - np.pi + centre
+    idx = np.rint(offset / res).astype(np.int64)
+    if n_beams * res >= TWO_PI - 0.5 * res:  # a full turn: the ends meet
+        return np.mod(idx, n_beams)
+    idx[(idx < 0) | (idx >= n_beams)] = -1
+    return idx
+
 
 @dataclass(frozen=True, eq=False)
 class Scan:
@@ -33,6 +69,11 @@ class Scan:
         Name of the sensor frame, without a leading ``/``.
     time_increment : float
         Time between consecutive beams, seconds (0 when unknown).
+    bearings : ndarray, shape (n,), optional
+        Exact bearing of each beam's reading, radians, where it is not quite the grid's: a
+        de-skewed scan (:func:`detection.deskew.deskew`) keeps each reading on the beam
+        nearest its true bearing, and its true bearing here, so :attr:`points` are exact.
+        The grid (``angle_min``, ``angle_increment``) still says which beam looks where.
     """
 
     ranges: np.ndarray
@@ -43,6 +84,7 @@ class Scan:
     stamp: float
     frame_id: str = "laser"
     time_increment: float = 0.0
+    bearings: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         ranges = np.array(self.ranges, dtype=np.float64)  # always a private copy
@@ -52,6 +94,12 @@ class Scan:
             raise ValueError(f"angle_increment must be finite and non-zero, got {self.angle_increment}")
         ranges.setflags(write=False)
         object.__setattr__(self, "ranges", ranges)
+        if self.bearings is not None:
+            bearings = np.array(self.bearings, dtype=np.float64)
+            if bearings.shape != ranges.shape:
+                raise ValueError(f"bearings must have the shape of ranges {ranges.shape}, got {bearings.shape}")
+            bearings.setflags(write=False)
+            object.__setattr__(self, "bearings", bearings)
         object.__setattr__(self, "frame_id", str(self.frame_id).lstrip("/"))
 
     @property
@@ -86,7 +134,10 @@ class Scan:
 
     @cached_property
     def angles(self) -> np.ndarray:
-        """Bearing of every beam in the sensor frame, radians, shape (n,)."""
+        """Bearing of every beam in the sensor frame, radians, shape (n,): the grid's, or
+        :attr:`bearings` where the scan has them."""
+        if self.bearings is not None:
+            return self.bearings
         a = self.angle_min + np.arange(self.n_beams, dtype=np.float64) * self.angle_increment
         a.setflags(write=False)
         return a
@@ -118,6 +169,10 @@ class Scan:
     def valid_points(self) -> np.ndarray:
         """Cartesian readings of the valid beams only, sensor frame, metres, shape (m, 2)."""
         return self.points[self.valid]
+
+    def beam_of(self, bearing) -> np.ndarray:
+        """Beam nearest each sensor-frame bearing (radians), -1 outside the view; see :func:`beam_index`."""
+        return beam_index(bearing, self.angle_min, self.angle_increment, self.n_beams)
 
     @property
     def beam_times(self) -> np.ndarray:

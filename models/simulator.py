@@ -153,19 +153,10 @@ class Simulation:
         t = self.time
         laser = self.laser
         stamp = self.t0 + t
-        # the robot moves while the beams sweep: poses at each beam's firing time
         sweep = laser.time_increment * (laser.n_beams - 1)
-        cmd = command if command is not None else (self.driver(t, self.robot) if self.driver else Command())
-        moving = abs(cmd.v) > 0 or abs(cmd.omega) > 0
-        if moving and sweep > 0:
-            # each beam fires from where the sensor is at its own time (base pose ∘ mount)
-            base = integrate_many(self.robot, cmd, np.arange(laser.n_beams) * laser.time_increment)
-            c, s_ = np.cos(base[:, 2]), np.sin(base[:, 2])
-            m = self.mount
-            beam_poses = np.column_stack([base[:, 0] + c * m.x - s_ * m.y, base[:, 1] + s_ * m.x + c * m.y,
-                                          base[:, 2] + m.yaw])
-        else:
-            beam_poses = self.robot @ self.mount
+        # the robot's path through this period; each beam fires from where it is on that path
+        path = self._path(command, sweep)
+        beam_poses = self._beam_poses(path, t + np.arange(laser.n_beams) * laser.time_increment)
         circles, owner = self._people_circles(t)
         all_circles = np.vstack([self.world.circles, circles]) if len(circles) else self.world.circles
         scan, hit = laser.render(stamp, beam_poses, self.world.segments, all_circles, self.rng)
@@ -183,30 +174,59 @@ class Simulation:
                       np.array([i in seen for i in ids], dtype=bool), beam_person)
         odom_pose = self._odometer.pose
         odometry = [self.odometry_now()] if self.index == 0 else []
-        odometry += self._advance(cmd, command is not None, sweep)
+        odometry += self._advance(path, t + sweep)
         self.index += 1
         return SimStep(scan, odom_pose, odometry, truth, self._odom_sweep_end)
 
-    def _advance(self, cmd: Command, external: bool, sweep: float = 0.0) -> list[OdometrySample]:
-        """Move the robot through one scan period; odometry samples on the way.
+    def _path(self, command: Command | None, sweep: float) -> list[tuple[float, float, Pose2D, Command, Pose2D]]:
+        """The robot's motion through one scan period, in physics steps.
 
-        Also notes the odometry pose at ``sweep`` seconds into the period (the last beam).
+        Each step is (start time, duration, start pose, command, end pose); the driver is
+        asked afresh at every step unless ``command`` (a closed loop) holds for the period.
+        A step ends exactly at ``sweep`` seconds in (the last beam).
         """
         dt = 1.0 / self.physics_hz
-        period = self.laser.period
         t = self.time
-        end = t + period
+        end = t + self.laser.period
         sweep_end = t + sweep
-        self._odom_sweep_end = self._odometer.pose
-        samples = []
+        pose = self.robot
+        cmd = command if command is not None else Command()
+        steps = []
         while t < end - 1e-12:
             h = min(dt, end - t)
             if t < sweep_end < t + h:
                 h = sweep_end - t  # land exactly on the last beam's time
-            if not external and self.driver is not None:
-                cmd = self.driver(t, self.robot)
-            new = integrate(self.robot, cmd, h)
-            odom_pose = self._odometer.update(t, self.robot, new)
+            if command is None and self.driver is not None:
+                cmd = self.driver(t, pose)
+            new = integrate(pose, cmd, h)
+            steps.append((t, h, pose, cmd, new))
+            pose, t = new, t + h
+        return steps
+
+    def _beam_poses(self, path, times: np.ndarray) -> Pose2D | np.ndarray:
+        """Sensor pose (x, y, yaw rows, world frame) at each of ``times`` along ``path``; one
+        Pose2D when the robot stands still."""
+        if all(abs(cmd.v) == 0 and abs(cmd.omega) == 0 for _, _, _, cmd, _ in path):
+            return self.robot @ self.mount
+        base = np.empty((len(times), 3))
+        step_of = np.clip(np.searchsorted([t0 for t0, *_ in path], times, side="right") - 1, 0, len(path) - 1)
+        for k in np.unique(step_of):
+            t0, _, pose, cmd, _ = path[k]
+            sel = step_of == k
+            base[sel] = integrate_many(pose, cmd, times[sel] - t0)
+        c, s_ = np.cos(base[:, 2]), np.sin(base[:, 2])
+        m = self.mount
+        return np.column_stack([base[:, 0] + c * m.x - s_ * m.y, base[:, 1] + s_ * m.x + c * m.y, base[:, 2] + m.yaw])
+
+    def _advance(self, path, sweep_end: float) -> list[OdometrySample]:
+        """Move the robot along ``path`` (one scan period); odometry samples on the way.
+
+        Also notes the odometry pose at ``sweep_end`` (the last beam's time).
+        """
+        self._odom_sweep_end = self._odometer.pose
+        samples = []
+        for t, h, pose, cmd, new in path:
+            odom_pose = self._odometer.update(t, pose, new)
             self.robot = new
             t += h
             if abs(t - sweep_end) < 1e-9:
@@ -214,7 +234,7 @@ class Simulation:
             if t >= self._next_odom - 1e-9:
                 samples.append(OdometrySample(self.t0 + t, odom_pose, cmd.v, cmd.omega))
                 self._next_odom += 1.0 / self.odom_rate_hz
-        self.time = end
+        self.time = self.time + self.laser.period
         return samples
 
     def odometry_now(self) -> OdometrySample:
