@@ -24,10 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
-from detection.align import AlignParams, ScanAligner
-from models.scenario import build_simulation, load_scenario
-from tracker.config import load_config
-from tracker.io.recording import Recording
+from people_tracker.detection.align import AlignParams, ScanAligner
+from people_tracker.models.scenario import build_simulation, load_scenario
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.io.recording import Recording
 
 DEFAULT_BAG = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
 
@@ -78,9 +78,9 @@ def moving_readings_far_from_people(path: Path, matching: bool, far: float = 1.0
     annotated person: static surfaces that misalignment made look moving."""
     from dataclasses import replace
 
-    from detection.detector import MovingObjectDetector
-    from detection.labels import MOVING
-    from tracker.io.ground_truth import read_bag_ground_truth
+    from people_tracker.detection.detector import MovingObjectDetector
+    from people_tracker.detection.labels import MOVING
+    from people_tracker.tracker.io.ground_truth import read_bag_ground_truth
 
     cfg = load_config()
     gt = read_bag_ground_truth(path)

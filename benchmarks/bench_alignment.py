@@ -5,7 +5,7 @@ Usage::
     python benchmarks/bench_alignment.py [BAG] [--repeat N]
 
 Scans are read, de-skewed and prepared as references beforehand; only
-:func:`detection.icp.match` is timed (768 beams on the annotated recording), with the
+:func:`people_tracker.detection.icp.match` is timed (768 beams on the annotated recording), with the
 odometry's relative motion as the prior. Prints p50/p99 milliseconds per match.
 """
 
@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from detection.deskew import deskew
-from detection.icp import ReferenceScan, match
-from tracker.config import load_config
-from tracker.io.recording import Recording
+from people_tracker.detection.deskew import deskew
+from people_tracker.detection.icp import ReferenceScan, match
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.io.recording import Recording
 
 DEFAULT_BAG = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
 

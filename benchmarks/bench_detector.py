@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from detection.detector import MovingObjectDetector
-from tracker.config import load_config
-from tracker.io.recording import Recording
+from people_tracker.detection.detector import MovingObjectDetector
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.io.recording import Recording
 
 DEFAULT_BAG = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
 

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from models.scenario import build_simulation, load_scenario
-from tracker.config import load_config
-from tracker.io.recording import Recording
-from tracker.people_tracker import PeopleTracker
+from people_tracker.models.scenario import build_simulation, load_scenario
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.io.recording import Recording
+from people_tracker.tracker.people_tracker import PeopleTracker
 
 DEFAULT_BAG = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
 

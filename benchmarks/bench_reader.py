@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tracker.config import config_from_dict
-from tracker.io.recording import Recording
+from people_tracker.tracker.config import config_from_dict
+from people_tracker.tracker.io.recording import Recording
 
 DEFAULT_BAG = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
 

@@ -20,8 +20,8 @@ import time
 
 import numpy as np
 
-from models.raycast import cast_rays
-from models.scenario import build_simulation, load_scenario
+from people_tracker.models.raycast import cast_rays
+from people_tracker.models.scenario import build_simulation, load_scenario
 
 
 def _report(name: str, times_s: list[float]) -> None:

@@ -22,13 +22,13 @@ import numpy as np
 
 from dataclasses import replace
 
-from detection.align import ScanAligner
-from detection.detector import MovingObjectDetector
-from tracker.config import load_config
-from tracker.errors import InputError
-from tracker.io.ground_truth import read_bag_ground_truth
-from tracker.io.recording import Recording
-from tracker.scan_checks import ScanChecker
+from people_tracker.detection.align import ScanAligner
+from people_tracker.detection.detector import MovingObjectDetector
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.ground_truth import read_bag_ground_truth
+from people_tracker.tracker.io.recording import Recording
+from people_tracker.tracker.scan_checks import ScanChecker
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh"
 

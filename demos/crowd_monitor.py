@@ -19,9 +19,9 @@ import time
 
 import numpy as np
 
-from models.scenario import build_simulation, load_scenario
-from tracker.config import load_config
-from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+from people_tracker.models.scenario import build_simulation, load_scenario
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 
 LINE_X = 7.0  # m, the counting line (world frame)
 ZONES = {"near left": (1, 7, 0, 6), "near right": (1, 7, -6, 0), "far left": (7, 14, 0, 6), "far right": (7, 14, -6, 0)}
@@ -66,7 +66,7 @@ def main(argv=None) -> int:
     if args.rrd:
         import rerun as rr
 
-        from tracker.viz_rerun import RerunSink
+        from people_tracker.tracker.viz_rerun import RerunSink
         sink = RerunSink(args.rrd, name="crowd-monitor")
     counts, truth_counts, present_counts = [], [], []
     zones_tracked = {z: [] for z in ZONES}

@@ -21,10 +21,10 @@ import time
 
 import numpy as np
 
-from models.robot import Command
-from models.scenario import build_simulation, load_scenario
-from tracker.config import load_config
-from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+from people_tracker.models.robot import Command
+from people_tracker.models.scenario import build_simulation, load_scenario
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 
 FOLLOW_DISTANCE_M = 1.2
 MAX_SPEED_MPS = 1.2
@@ -55,7 +55,7 @@ def main(argv=None) -> int:
     tracker = PeopleTracker.from_config(load_config(), follow="auto")
     sink = None
     if args.rrd:
-        from tracker.viz_rerun import RerunSink
+        from people_tracker.tracker.viz_rerun import RerunSink
         sink = RerunSink(args.rrd, name="follow-person")
     command = Command()
     gaps, lost, wrong, target_ids = [], 0, 0, []

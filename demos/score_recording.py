@@ -15,8 +15,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from tracker.bench import bench_recording
-from tracker.config import load_config
+from people_tracker.tracker.bench import bench_recording
+from people_tracker.tracker.config import load_config
 
 DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
 PUBLISHED = {"mota": 0.102, "motp_m": 0.15, "id_switches": 2, "misses": 480, "false_positives": 97, "matches": 163,

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from detection.deskew import deskew, sweep_duration
-from detection.icp import IcpParams, MatchResult, ReferenceScan, match
-from models.pose import Pose2D, interpolate_pose, pairwise_distances
-from models.scan import Scan
+from people_tracker.detection.deskew import deskew, sweep_duration
+from people_tracker.detection.icp import IcpParams, MatchResult, ReferenceScan, match
+from people_tracker.models.pose import Pose2D, interpolate_pose, pairwise_distances
+from people_tracker.models.scan import Scan
 
 
 @dataclass(frozen=True)

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from models.pose import Pose2D
-from models.scan import Scan, beam_index
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.scan import Scan, beam_index
 
 
 def sweep_duration(scan: Scan) -> float:
@@ -46,7 +46,7 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
     plus the rotation per beam (a sensor turning against its sweep direction packs its
     beams closer). A sweep that only turns then moves no reading off its beam and loses
     none. The translation moves each reading's bearing by an amount that depends on its
-    range; each goes to the beam nearest its new bearing (:func:`models.scan.beam_index`),
+    range; each goes to the beam nearest its new bearing (:func:`people_tracker.models.scan.beam_index`),
     the nearest reading wins where two meet (the other is hidden from the first pose),
     and readings that leave the field of view are dropped. Each keeps its exact bearing
     (:attr:`Scan.bearings`), so the scan's points are where the first pose would have seen

@@ -13,15 +13,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from detection.closest import closest_point_static
-from detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
-from detection.objects import MovingObject, describe
-from detection.recover import isolated_occluded, recover_moving
-from detection.scan_lines import bin_to_beams, scan_line_labels
-from detection.segments import split_runs
-from detection.thresholds import range_threshold
-from models.pose import Pose2D, pairwise_distances
-from models.scan import Scan
+from people_tracker.detection.closest import closest_point_static
+from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
+from people_tracker.detection.objects import MovingObject, describe
+from people_tracker.detection.recover import isolated_occluded, recover_moving
+from people_tracker.detection.scan_lines import bin_to_beams, scan_line_labels
+from people_tracker.detection.segments import split_runs
+from people_tracker.detection.thresholds import range_threshold
+from people_tracker.models.pose import Pose2D, pairwise_distances
+from people_tracker.models.scan import Scan
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,7 @@ class DetectorParams:
         Algorithm 3 runs when O_C has at most this many segments (the single-object condition).
     isolated_o_objects
         Also take free-standing, person-sized O segments as objects moving away, whatever
-        else moves (an extension of Algorithm 3; see :func:`detection.recover.isolated_occluded`).
+        else moves (an extension of Algorithm 3; see :func:`people_tracker.detection.recover.isolated_occluded`).
     no_return_free_m
         A previous beam with no return (``inf``, REP 117) counts as a line of sight seen
         through up to this range (m; capped at range_max) in Algorithm 1, so a reading in
@@ -93,7 +93,7 @@ class Detection:
     Attributes
     ----------
     labels : ndarray of int8, shape (n_beams,)
-        Set of each reading of the current scan (``detection.labels``).
+        Set of each reading of the current scan (``people_tracker.detection.labels``).
     objects : list of MovingObject
     compared_dt_s : tuple of float
         Actual Δt (s) to each earlier scan compared with; empty when there was none yet.

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from detection.scan_lines import bin_to_beams
-from models.pose import Pose2D
-from models.scan import Scan
+from people_tracker.detection.scan_lines import bin_to_beams
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.scan import Scan
 
 
 def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: float,

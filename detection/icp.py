@@ -14,7 +14,7 @@ import numpy as np
 from scipy.linalg.lapack import dsyev
 from scipy.spatial import cKDTree
 
-from models.pose import Pose2D, wrap_angle
+from people_tracker.models.pose import Pose2D, wrap_angle
 
 
 @dataclass(frozen=True)

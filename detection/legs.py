@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from detection.segments import run_bounds
-from detection.thresholds import range_threshold
-from models.scan import Scan
+from people_tracker.detection.segments import run_bounds
+from people_tracker.detection.thresholds import range_threshold
+from people_tracker.models.scan import Scan
 
 
 def free_standing_legs(scan: Scan, k_segment: float, segment_floor_m: float, min_points: int,

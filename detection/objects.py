@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
-from detection.labels import MOVING, NAMES, OCCLUDED, STATIC
+from people_tracker.detection.labels import MOVING, NAMES, OCCLUDED, STATIC
 
 
 @dataclass(frozen=True, eq=False)

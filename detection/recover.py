@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from detection.labels import MOVING, OCCLUDED, STATIC
-from detection.segments import Segment
+from people_tracker.detection.labels import MOVING, OCCLUDED, STATIC
+from people_tracker.detection.segments import Segment
 
 
 def join(runs: list[Segment], into: int, source: int, points: np.ndarray, join_threshold: np.ndarray,

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW
-from models.scan import beam_index
+from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW
+from people_tracker.models.scan import beam_index
 
 
 def bin_to_beams(points: np.ndarray, angle_min: float, angle_increment: float, n_beams: int) -> np.ndarray:

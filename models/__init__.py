@@ -3,7 +3,7 @@
 Imports nothing from ``detection`` or ``tracker``.
 """
 
-from models.pose import Pose2D
-from models.scan import Scan
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.scan import Scan
 
 __all__ = ["Pose2D", "Scan"]

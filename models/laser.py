@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.pose import Pose2D
-from models.raycast import cast_rays
-from models.scan import Scan
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.raycast import cast_rays
+from people_tracker.models.scan import Scan
 
 
 @dataclass(frozen=True)
@@ -97,7 +97,7 @@ class LaserModel:
             Sensor pose in the world frame; one pose, or one for each beam (a moving sensor
             fires each beam from where it is at that instant), as Pose2D or rows x, y, yaw.
         segments, circles : ndarray
-            The scene in the world frame (see :func:`models.raycast.cast_rays`).
+            The scene in the world frame (see :func:`people_tracker.models.raycast.cast_rays`).
         rng : numpy.random.Generator, optional
             Source of noise and dropouts; without it the scan is noise-free.
 

@@ -8,7 +8,7 @@ from typing import Callable
 
 import numpy as np
 
-from models.pose import Pose2D, wrap_angle
+from people_tracker.models.pose import Pose2D, wrap_angle
 
 
 @dataclass(frozen=True)

@@ -71,7 +71,7 @@ class Scan:
         Time between consecutive beams, seconds (0 when unknown).
     bearings : ndarray, shape (n,), optional
         Exact bearing of each beam's reading, radians, where it is not quite the grid's: a
-        de-skewed scan (:func:`detection.deskew.deskew`) keeps each reading on the beam
+        de-skewed scan (:func:`people_tracker.detection.deskew.deskew`) keeps each reading on the beam
         nearest its true bearing, and its true bearing here, so :attr:`points` are exact.
         The grid (``angle_min``, ``angle_increment``) still says which beam looks where.
     """

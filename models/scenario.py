@@ -28,12 +28,12 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from models.laser import LaserModel
-from models.person import PersonModel, Walker
-from models.pose import Pose2D
-from models.robot import FollowDriver, ScriptedDriver, WaypointDriver
-from models.simulator import Simulation
-from models.world import build_world
+from people_tracker.models.laser import LaserModel
+from people_tracker.models.person import PersonModel, Walker
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.robot import FollowDriver, ScriptedDriver, WaypointDriver
+from people_tracker.models.simulator import Simulation
+from people_tracker.models.world import build_world
 
 
 class ScenarioError(ValueError):
@@ -55,7 +55,7 @@ _KEYS = {
 
 def scenario_names() -> list[str]:
     """Names of the scenarios shipped in ``configs/scenarios``."""
-    folder = resources.files("configs").joinpath("scenarios")
+    folder = resources.files("people_tracker.configs").joinpath("scenarios")
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".yaml"))
 
 
@@ -67,7 +67,7 @@ def load_scenario(name_or_path: str | Path) -> dict:
             raise ScenarioError(f"scenario file '{p}' does not exist")
         text, origin = p.read_text(encoding="utf-8"), f"scenario file '{p}'"
     else:
-        f = resources.files("configs").joinpath("scenarios", f"{name_or_path}.yaml")
+        f = resources.files("people_tracker.configs").joinpath("scenarios", f"{name_or_path}.yaml")
         if not f.is_file():
             raise ScenarioError(f"no scenario '{name_or_path}' (shipped: {', '.join(scenario_names())})")
         text, origin = f.read_text(encoding="utf-8"), f"scenario '{name_or_path}'"

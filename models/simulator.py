@@ -13,12 +13,12 @@ from typing import Callable
 
 import numpy as np
 
-from models.laser import LaserModel
-from models.person import Walker
-from models.pose import Pose2D
-from models.robot import Command, Odometer, integrate, integrate_many
-from models.scan import Scan
-from models.world import World
+from people_tracker.models.laser import LaserModel
+from people_tracker.models.person import Walker
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.robot import Command, Odometer, integrate, integrate_many
+from people_tracker.models.scan import Scan
+from people_tracker.models.world import World
 
 VISIBLE_MIN_POINTS = 3  # Leigh et al.: a person is visible with 3 points ...
 VISIBLE_SPACING_M = 0.13  # ... in one cluster at 0.13 m spacing

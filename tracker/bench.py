@@ -23,15 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
-from tracker.config import Config
-from tracker.errors import InputError
-from tracker.evaluation import TrackRows, evaluate
-from tracker.io.bag import LASER_SCAN, open_bag, topics_of_type
-from tracker.io.ground_truth import GroundTruth, read_bag_ground_truth
-from tracker.io.recording import Recording
-from tracker.io.simulated import SimulatedSource
-from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
-from tracker.scan_checks import ScanChecker
+from people_tracker.tracker.config import Config
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.evaluation import TrackRows, evaluate
+from people_tracker.tracker.io.bag import LASER_SCAN, open_bag, topics_of_type
+from people_tracker.tracker.io.ground_truth import GroundTruth, read_bag_ground_truth
+from people_tracker.tracker.io.recording import Recording
+from people_tracker.tracker.io.simulated import SimulatedSource
+from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+from people_tracker.tracker.scan_checks import ScanChecker
 
 LEIGH_WINDOW_DEG = (-80.0, 12.0)  # the bearings Leigh et al. scored on the moving-robot recordings
 SCENES = ("crossing", "stop_and_go", "occlusion", "following", "corridor", "crowd")

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tracker.errors import InputError
+from people_tracker.tracker.errors import InputError
 
 PROG = "people-tracker"
 
@@ -103,7 +103,7 @@ def _progress(total: int, quiet: bool):
 
 
 def _print_v_min(params, resolution: float) -> None:
-    from detection.detector import v_min
+    from people_tracker.detection.detector import v_min
 
     for dt, speeds in v_min(params, resolution).items():
         print(f"V_min = Δd_c/Δt for Δt {dt:g} s: " + ", ".join(
@@ -113,9 +113,9 @@ def _print_v_min(params, resolution: float) -> None:
 def _cmd_run(args) -> int:
     import contextlib
 
-    from tracker.config import load_config
-    from tracker.io.atomic import check_writable
-    from tracker.io.recording import Recording
+    from people_tracker.tracker.config import load_config
+    from people_tracker.tracker.io.atomic import check_writable
+    from people_tracker.tracker.io.recording import Recording
 
     config = load_config(args.config)
     follow = None
@@ -133,7 +133,7 @@ def _cmd_run(args) -> int:
     sink = _make_sink(args)
     try:
         if args.input is None:
-            from tracker.io.simulated import DEFAULT_SCENE, SimulatedSource
+            from people_tracker.tracker.io.simulated import DEFAULT_SCENE, SimulatedSource
             source = SimulatedSource(DEFAULT_SCENE)
         else:
             source = Recording(args.input, args.topic, config.odometry)
@@ -147,7 +147,7 @@ def _cmd_run(args) -> int:
 
 def _ground_truth_by_scan(path, topic) -> dict | None:
     """Sensor-frame ground truth per scan index of an annotated recording (None without)."""
-    from tracker.io.ground_truth import read_bag_ground_truth
+    from people_tracker.tracker.io.ground_truth import read_bag_ground_truth
 
     gt = read_bag_ground_truth(path, topic, required=False)
     if gt is None:
@@ -159,20 +159,20 @@ def _ground_truth_by_scan(path, topic) -> dict | None:
 
 
 def _make_sink(args):
-    from tracker.sinks import NullSink
+    from people_tracker.tracker.sinks import NullSink
 
     if not (args.rrd or args.spawn):
         return NullSink()
-    from tracker.viz_rerun import RerunSink
+    from people_tracker.tracker.viz_rerun import RerunSink
     return RerunSink(args.rrd, args.spawn)
 
 
 def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
-    from tracker.config import dump_config
-    from tracker.io import outputs
-    from tracker.io.atomic import atomic_output
-    from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
-    from tracker.scan_checks import ScanChecker
+    from people_tracker.tracker.config import dump_config
+    from people_tracker.tracker.io import outputs
+    from people_tracker.tracker.io.atomic import atomic_output
+    from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+    from people_tracker.tracker.scan_checks import ScanChecker
 
     log = logging.getLogger(PROG)
     with source as rec, stack:
@@ -261,10 +261,10 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
 def _cmd_evaluate(args) -> int:
     import json
 
-    from tracker.evaluation import evaluate, format_table
-    from tracker.io.atomic import atomic_output, check_writable
-    from tracker.io.ground_truth import read_ground_truth
-    from tracker.io.tracks_csv import read_tracks_csv
+    from people_tracker.tracker.evaluation import evaluate, format_table
+    from people_tracker.tracker.io.atomic import atomic_output, check_writable
+    from people_tracker.tracker.io.ground_truth import read_ground_truth
+    from people_tracker.tracker.io.tracks_csv import read_tracks_csv
 
     for name, value in (("--threshold", args.threshold), ("--ospa-cutoff", args.ospa_cutoff),
                         ("--ospa-order", args.ospa_order)):
@@ -290,7 +290,7 @@ def _cmd_evaluate(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from tracker.io.simulated import simulate_to_bag
+    from people_tracker.tracker.io.simulated import simulate_to_bag
 
     if args.people is not None and args.people < 0:
         raise InputError("--people must be 0 or more")
@@ -306,8 +306,8 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_bench(args) -> int:
-    from tracker.bench import run_bench
-    from tracker.config import load_config
+    from people_tracker.tracker.bench import run_bench
+    from people_tracker.tracker.config import load_config
 
     config = load_config(args.config)
     data = Path(args.data or os.environ.get("PEOPLE_TRACKER_DATA") or "../shared/data")

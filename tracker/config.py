@@ -2,7 +2,7 @@
 
 ``configs/default.yaml`` (shipped in the wheel) holds every tunable and its unit; a user
 file given with ``--config`` overrides any subset of it. Unknown keys, wrong types and
-out-of-range values raise :class:`~tracker.errors.InputError` naming the key.
+out-of-range values raise :class:`~people_tracker.tracker.errors.InputError` naming the key.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from typing import Any
 
 import yaml
 
-from tracker.errors import InputError
+from people_tracker.tracker.errors import InputError
 
 
 def _spec(*, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
@@ -47,7 +47,7 @@ class ScanChecksConfig:
 
 @dataclass(frozen=True)
 class DetectorConfig:
-    """The paper's detector; see :class:`detection.detector.DetectorParams`."""
+    """The paper's detector; see :class:`people_tracker.detection.detector.DetectorParams`."""
 
     compare_dt_s: tuple = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     k_closest: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
@@ -69,7 +69,7 @@ class DetectorConfig:
 
     def params(self):
         """The detector's own parameter object."""
-        from detection.detector import DetectorParams
+        from people_tracker.detection.detector import DetectorParams
         return _params_of(self, DetectorParams)
 
 
@@ -79,7 +79,7 @@ def _params_of(section, cls):
 
 @dataclass(frozen=True)
 class PairingConfig:
-    """Leg pairing; see :class:`tracker.pairing.PairingParams`."""
+    """Leg pairing; see :class:`people_tracker.tracker.pairing.PairingParams`."""
 
     min_leg_size_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
     max_leg_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
@@ -90,13 +90,13 @@ class PairingConfig:
     sigma_blob_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
 
     def params(self):
-        from tracker.pairing import PairingParams
+        from people_tracker.tracker.pairing import PairingParams
         return _params_of(self, PairingParams)
 
 
 @dataclass(frozen=True)
 class TracksConfig:
-    """Track filter and lifecycle; see :class:`tracker.tracks.TrackParams`."""
+    """Track filter and lifecycle; see :class:`people_tracker.tracker.tracks.TrackParams`."""
 
     accel_std_mps2: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
     init_speed_std_mps: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
@@ -109,13 +109,13 @@ class TracksConfig:
     max_tentative_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3600.0))
 
     def params(self):
-        from tracker.tracks import TrackParams
+        from people_tracker.tracker.tracks import TrackParams
         return _params_of(self, TrackParams)
 
 
 @dataclass(frozen=True)
 class AssociationConfig:
-    """Association and static support; see :class:`tracker.people_tracker.AssociationParams`."""
+    """Association and static support; see :class:`people_tracker.tracker.people_tracker.AssociationParams`."""
 
     method: str = field(metadata=_spec(choices=("gnn", "nn")))
     gate_chi2: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
@@ -129,13 +129,13 @@ class AssociationConfig:
     recover_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
 
     def params(self):
-        from tracker.people_tracker import AssociationParams
+        from people_tracker.tracker.people_tracker import AssociationParams
         return _params_of(self, AssociationParams)
 
 
 @dataclass(frozen=True)
 class StandingConfig:
-    """Standing people found by leg shape; see :class:`tracker.standing.StandingParams`."""
+    """Standing people found by leg shape; see :class:`people_tracker.tracker.standing.StandingParams`."""
 
     enabled: bool = field(metadata=_spec())
     min_points: int = field(metadata=_spec(lo=1, hi=10000))
@@ -150,13 +150,13 @@ class StandingConfig:
     furniture_radius_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
 
     def params(self):
-        from tracker.standing import StandingParams
+        from people_tracker.tracker.standing import StandingParams
         return _params_of(self, StandingParams)
 
 
 @dataclass(frozen=True)
 class AlignmentConfig:
-    """Scan matching; see :class:`detection.align.AlignParams` and :class:`detection.icp.IcpParams`."""
+    """Scan matching; see :class:`people_tracker.detection.align.AlignParams` and :class:`people_tracker.detection.icp.IcpParams`."""
 
     enabled: bool = field(metadata=_spec())
     exclude_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
@@ -174,8 +174,8 @@ class AlignmentConfig:
     max_source_points: int = field(metadata=_spec(lo=0, hi=1000000))
 
     def params(self):
-        from detection.align import AlignParams
-        from detection.icp import IcpParams
+        from people_tracker.detection.align import AlignParams
+        from people_tracker.detection.icp import IcpParams
         icp = {k: v for k, v in dataclasses.asdict(self).items() if k not in ("enabled", "exclude_radius_m")}
         return AlignParams(self.enabled, self.exclude_radius_m, IcpParams(**icp))
 
@@ -202,7 +202,7 @@ class Config:
 
 
 def _default_text() -> str:
-    return resources.files("configs").joinpath("default.yaml").read_text(encoding="utf-8")
+    return resources.files("people_tracker.configs").joinpath("default.yaml").read_text(encoding="utf-8")
 
 
 def _merge(base: dict, override: dict, where: str) -> dict:

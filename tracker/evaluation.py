@@ -26,8 +26,8 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from models.pose import pairwise_distances
-from tracker.io.ground_truth import GroundTruth
+from people_tracker.models.pose import pairwise_distances
+from people_tracker.tracker.io.ground_truth import GroundTruth
 
 
 @dataclass(frozen=True, eq=False)

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from models.pose import Pose2D
+from people_tracker.models.pose import Pose2D
 
 
 class TargetSelector:

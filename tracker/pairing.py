@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.pose import pairwise_distances
+from people_tracker.models.pose import pairwise_distances
 
 
 @dataclass(frozen=True)

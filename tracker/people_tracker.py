@@ -13,18 +13,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from detection.align import Alignment, AlignParams, ScanAligner
-from detection.detector import Detection, DetectorParams, MovingObjectDetector
-from detection.free_space import seen_through
-from detection.legs import free_standing_legs
-from models.pose import Pose2D, pairwise_distances
-from models.scan import Scan
-from tracker.association import associate, mahalanobis_costs
-from tracker.following import TargetSelector
-from tracker.pairing import PairingParams, PersonCandidate, owners, pair_legs
-from tracker.standing import StandingInitiator, StandingParams, standing_pairs
-from tracker.static_support import static_support
-from tracker.tracks import Track, TrackParams, TrackState
+from people_tracker.detection.align import Alignment, AlignParams, ScanAligner
+from people_tracker.detection.detector import Detection, DetectorParams, MovingObjectDetector
+from people_tracker.detection.free_space import seen_through
+from people_tracker.detection.legs import free_standing_legs
+from people_tracker.models.pose import Pose2D, pairwise_distances
+from people_tracker.models.scan import Scan
+from people_tracker.tracker.association import associate, mahalanobis_costs
+from people_tracker.tracker.following import TargetSelector
+from people_tracker.tracker.pairing import PairingParams, PersonCandidate, owners, pair_legs
+from people_tracker.tracker.standing import StandingInitiator, StandingParams, standing_pairs
+from people_tracker.tracker.static_support import static_support
+from people_tracker.tracker.tracks import Track, TrackParams, TrackState
 
 
 @dataclass(frozen=True)
@@ -85,7 +85,7 @@ class PeopleTracker:
     ----------
     detector, pairing, tracks, association : parameter objects
     follow : 'auto', a track id, or None
-        Which person to follow (see :class:`~tracker.following.TargetSelector`).
+        Which person to follow (see :class:`~people_tracker.tracker.following.TargetSelector`).
     """
 
     def __init__(self, detector: DetectorParams | None = None, pairing: PairingParams | None = None,
@@ -105,7 +105,7 @@ class PeopleTracker:
 
     @classmethod
     def from_config(cls, config, follow: str | int | None = None) -> "PeopleTracker":
-        """A tracker from a resolved :class:`tracker.config.Config`."""
+        """A tracker from a resolved :class:`people_tracker.tracker.config.Config`."""
         return cls(config.detector.params(), config.pairing.params(), config.tracks.params(),
                    config.association.params(), follow, config.alignment.params(), config.standing.params())
 

@@ -13,7 +13,7 @@ import statistics
 from collections import deque
 from dataclasses import dataclass
 
-from models.scan import Scan
+from people_tracker.models.scan import Scan
 
 _PERIOD_WINDOW = 25  # recent stamp intervals that define the typical period
 

@@ -1,7 +1,7 @@
 """Where each step's results go besides the CSV files: a sink interface with a do-nothing default.
 
 The tracking core never imports a display library; the application hands a sink each
-step's :class:`~tracker.people_tracker.StepResult`.
+step's :class:`~people_tracker.tracker.people_tracker.StepResult`.
 """
 
 from __future__ import annotations

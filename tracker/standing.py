@@ -3,11 +3,11 @@
 Someone who stands still never moves, so motion detection (the paper's method) never
 reports them; on the annotated hallway recording most of the people are standing. Their
 legs still look like legs: two free-standing leg-shaped segments (see
-:func:`detection.legs.free_standing_legs`) a stance apart. Such a pair starts a track
+:func:`people_tracker.detection.legs.free_standing_legs`) a stance apart. Such a pair starts a track
 only when it comes back at the same place in the world in most of the last few scans (a
 one-off coincidence of two unrelated segments does not), never near an existing track,
 and never where a standing track was already ended as furniture: a standing track that
-has not moved after ``max_static_s`` (see :class:`~tracker.tracks.TrackParams`) is
+has not moved after ``max_static_s`` (see :class:`~people_tracker.tracker.tracks.TrackParams`) is
 deleted and its place remembered, so a pair of table legs costs one short track, not one
 every few seconds.
 """
@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.pose import pairwise_distances
-from tracker.pairing import nearest_pairs
+from people_tracker.models.pose import pairwise_distances
+from people_tracker.tracker.pairing import nearest_pairs
 
 
 @dataclass(frozen=True)

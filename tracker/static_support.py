@@ -6,17 +6,17 @@ scan's own readings near its prediction are looked at: the segments (all reading
 set) that come within ``radius`` of the prediction are united, and if together they are
 person-sized they support the track at their centre — the paper's Join with A_C, lifted
 from one scan to a track. Static support never starts a track, and a track kept only by
-it is deleted after ``max_static_s`` (see :class:`~tracker.tracks.TrackParams`).
+it is deleted after ``max_static_s`` (see :class:`~people_tracker.tracker.tracks.TrackParams`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from detection.segments import split_runs
-from detection.thresholds import range_threshold
-from models.pose import Pose2D, pairwise_distances
-from models.scan import Scan
+from people_tracker.detection.segments import split_runs
+from people_tracker.detection.thresholds import range_threshold
+from people_tracker.models.pose import Pose2D, pairwise_distances
+from people_tracker.models.scan import Scan
 
 
 def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_segment: float,

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
-from models.motion import H, constant_velocity_FQ
+from people_tracker.models.motion import H, constant_velocity_FQ
 
 
 @dataclass(frozen=True)

@@ -31,9 +31,9 @@ import rerun as rr
 import rerun.blueprint as rrb
 import shapely
 
-from detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
-from tracker.io.atomic import publish
-from tracker.sinks import Sink
+from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
+from people_tracker.tracker.io.atomic import publish
+from people_tracker.tracker.sinks import Sink
 
 _SET_COLOURS = [(STATIC, "A static", (150, 150, 150)), (MOVING, "M moving", (230, 40, 40)),
                 (OCCLUDED, "O occluded", (255, 160, 0)), (OUT_OF_VIEW, "N out of view", (60, 110, 255))]

@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from detection.icp import IcpParams, ReferenceScan, line_normals, match
-from models.pose import Pose2D
-from models.world import build_world
-from models.laser import LaserModel
+from people_tracker.detection.icp import IcpParams, ReferenceScan, line_normals, match
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.world import build_world
+from people_tracker.models.laser import LaserModel
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from alignment_accuracy import plain_corridor, simulated_errors  # noqa: E402

@@ -16,10 +16,10 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from detection.deskew import deskew, deskew_with_source
-from models.pose import Pose2D, wrap_angle
-from models.raycast import cast_rays
-from models.scan import Scan, beam_index
+from people_tracker.detection.deskew import deskew, deskew_with_source
+from people_tracker.models.pose import Pose2D, wrap_angle
+from people_tracker.models.raycast import cast_rays
+from people_tracker.models.scan import Scan, beam_index
 
 TWO_PI = 2.0 * math.pi
 SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from detection.legs import free_standing_legs
-from models.scenario import build_simulation
+from people_tracker.detection.legs import free_standing_legs
+from people_tracker.models.scenario import build_simulation
 
 LASER = {"fov_deg": 270, "resolution_deg": 0.35, "rate_hz": 10, "range_max": 20, "noise_std": 0.0}
 

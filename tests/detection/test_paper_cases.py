@@ -11,8 +11,8 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from detection.detector import DetectorParams, MovingObjectDetector
-from models.scenario import build_simulation, load_scenario
+from people_tracker.detection.detector import DetectorParams, MovingObjectDetector
+from people_tracker.models.scenario import build_simulation, load_scenario
 
 PARAMS = DetectorParams(compare_dt_s=(0.15, 0.45))
 

@@ -5,16 +5,16 @@ import math
 import numpy as np
 import pytest
 
-from detection.closest import closest_point_static
-from detection.detector import DetectorParams, MovingObjectDetector, combine, label_pair
-from detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
-from detection.objects import describe, recovered_name
-from detection.recover import join, recover_moving
-from detection.scan_lines import bin_to_beams, scan_line_labels
-from detection.segments import Segment, split_runs
-from detection.thresholds import range_threshold
-from models.pose import Pose2D
-from models.scan import Scan
+from people_tracker.detection.closest import closest_point_static
+from people_tracker.detection.detector import DetectorParams, MovingObjectDetector, combine, label_pair
+from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
+from people_tracker.detection.objects import describe, recovered_name
+from people_tracker.detection.recover import join, recover_moving
+from people_tracker.detection.scan_lines import bin_to_beams, scan_line_labels
+from people_tracker.detection.segments import Segment, split_runs
+from people_tracker.detection.thresholds import range_threshold
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.scan import Scan
 
 
 def test_threshold_grows_with_range_and_resolution_and_has_a_floor():
@@ -140,7 +140,7 @@ def test_detector_finds_an_object_that_appears_and_keeps_history_by_time():
 
 
 def test_free_space_sees_through_empty_places_only():
-    from detection.free_space import seen_through
+    from people_tracker.detection.free_space import seen_through
     ranges = np.array([5.0, np.inf, np.nan, 2.0, 2.0, 0.0])
     scan = Scan(ranges, -0.25, 0.1, 0.05, 10.0, stamp=0.0)  # beams at -0.25 … 0.25 rad
     pose = Pose2D(1.0, 0.0, 0.0)  # the sensor 1 m along x in the world
@@ -202,7 +202,7 @@ def test_no_return_counts_as_seen_through_only_when_asked():
 
 
 def test_deskew_keeps_no_return_beams():
-    from detection.deskew import deskew
+    from people_tracker.detection.deskew import deskew
     r = np.full(181, 4.0)
     r[100:120] = np.inf
     ang = np.radians(np.linspace(-90, 90, 181))

@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from models.pose import Pose2D, interpolate_pose, wrap_angle, yaw_from_quaternion
+from people_tracker.models.pose import Pose2D, interpolate_pose, wrap_angle, yaw_from_quaternion
 
 
 def test_compose_inverse_is_identity_and_matches_matrices():

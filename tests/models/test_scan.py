@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from models.scan import Scan
+from people_tracker.models.scan import Scan
 
 
 def make(ranges, inc=0.1, amin=-0.5, rmin=0.1, rmax=10.0):

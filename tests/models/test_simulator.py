@@ -6,14 +6,14 @@ import math
 import numpy as np
 import pytest
 
-from models.laser import LaserModel
-from models.person import PersonModel, Walker
-from models.pose import Pose2D
-from models.raycast import cast_rays
-from models.scenario import ScenarioError, build_simulation, load_scenario, scenario_names
-from models.simulator import Simulation, visible_people
-from models.world import World, build_world
-from models.scan import Scan
+from people_tracker.models.laser import LaserModel
+from people_tracker.models.person import PersonModel, Walker
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.raycast import cast_rays
+from people_tracker.models.scenario import ScenarioError, build_simulation, load_scenario, scenario_names
+from people_tracker.models.simulator import Simulation, visible_people
+from people_tracker.models.world import World, build_world
+from people_tracker.models.scan import Scan
 
 
 def test_rendered_ranges_equal_the_analytic_ones():
@@ -169,7 +169,7 @@ def test_bad_scenarios_name_the_key(tmp_path, bad, key):
 
 @pytest.mark.parametrize("seed", range(6))
 def test_culled_ray_caster_equals_the_dense_one(seed):
-    from models.raycast import cast_rays_dense
+    from people_tracker.models.raycast import cast_rays_dense
     rng = np.random.default_rng(seed)
     n = 500
     clockwise = seed % 2 == 1

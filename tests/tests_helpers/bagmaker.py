@@ -7,9 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from models.pose import Pose2D
-from models.scan import Scan
-from tracker.io.bag_writer import BagWriter
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.scan import Scan
+from people_tracker.tracker.io.bag_writer import BagWriter
 
 MOUNT = Pose2D(0.30, -0.10, math.radians(30.0))  # base_link -> laser
 

@@ -53,8 +53,8 @@ def test_not_a_recording(tmp_path):
 
 
 def test_no_laser_scan_topic(tmp_path):
-    from tracker.io.bag_writer import BagWriter
-    from models.pose import Pose2D
+    from people_tracker.tracker.io.bag_writer import BagWriter
+    from people_tracker.models.pose import Pose2D
     with BagWriter(tmp_path / "odom_only", "mcap") as w:
         w.write_odometry("/odom", 1.0, "odom", "base_link", Pose2D())
     assert_one_line_error(run_cli("run", str(tmp_path / "odom_only")), "no LaserScan topic", "/odom")

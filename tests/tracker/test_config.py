@@ -3,8 +3,8 @@ from importlib import resources
 
 import pytest
 
-from tracker.config import Config, config_from_dict, dump_config, load_config
-from tracker.errors import InputError
+from people_tracker.tracker.config import Config, config_from_dict, dump_config, load_config
+from people_tracker.tracker.errors import InputError
 
 
 def test_defaults_load_into_frozen_dataclasses():
@@ -15,7 +15,7 @@ def test_defaults_load_into_frozen_dataclasses():
 
 
 def test_default_yaml_ships_with_the_package_and_every_tunable_has_a_unit_comment():
-    text = resources.files("configs").joinpath("default.yaml").read_text()
+    text = resources.files("people_tracker.configs").joinpath("default.yaml").read_text()
     leaves = [ln for ln in text.splitlines() if re.match(r"^\s+\w+:\s*\S", ln)]
     assert leaves, "no tunables found"
     for line in leaves:

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from tests_helpers import run_cli
-from tracker.evaluation import TrackRows, evaluate, ospa
-from tracker.io.ground_truth import GroundTruth, read_bag_ground_truth
+from people_tracker.tracker.evaluation import TrackRows, evaluate, ospa
+from people_tracker.tracker.io.ground_truth import GroundTruth, read_bag_ground_truth
 
 
 def gt_of(rows, n_frames=None):

@@ -1,7 +1,7 @@
 import pytest
 
-from tracker.errors import InputError
-from tracker.io.ground_truth import read_ground_truth, read_gt_csv
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.ground_truth import read_ground_truth, read_gt_csv
 
 
 def test_csv_ground_truth_reads_and_sorts(tmp_path):

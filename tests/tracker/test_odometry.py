@@ -2,8 +2,8 @@ import math
 
 import pytest
 
-from models.pose import Pose2D
-from tracker.io.odometry import PoseSeries, TfTree, compose_chain
+from people_tracker.models.pose import Pose2D
+from people_tracker.tracker.io.odometry import PoseSeries, TfTree, compose_chain
 
 
 def series(**kw):

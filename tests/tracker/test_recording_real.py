@@ -5,11 +5,11 @@ import pytest
 from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation
 
-from models.pose import wrap_angle
-from tracker.config import config_from_dict
-from tracker.errors import InputError
-from tracker.io.ground_truth import read_bag_ground_truth
-from tracker.io.recording import Recording
+from people_tracker.models.pose import wrap_angle
+from people_tracker.tracker.config import config_from_dict
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.ground_truth import read_bag_ground_truth
+from people_tracker.tracker.io.recording import Recording
 
 
 def _records(path, topic=None, source="auto"):

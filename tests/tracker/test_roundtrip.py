@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from models.pose import wrap_angle
+from people_tracker.models.pose import wrap_angle
 from tests_helpers import bagmaker
-from tracker.config import config_from_dict
-from tracker.io.recording import Recording
+from people_tracker.tracker.config import config_from_dict
+from people_tracker.tracker.io.recording import Recording
 
 
 def _read(path, source="auto", topic=None):

@@ -1,7 +1,7 @@
 import numpy as np
 
-from models.scan import Scan
-from tracker.scan_checks import ScanChecker
+from people_tracker.models.scan import Scan
+from people_tracker.tracker.scan_checks import ScanChecker
 
 
 def scan(stamp, n=100, ranges=None):

@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from models.scenario import build_simulation, load_scenario, scenario_names
-from tracker.config import load_config
-from tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+from people_tracker.models.scenario import build_simulation, load_scenario, scenario_names
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 
 MOVING_SCENES = [n for n in scenario_names() if any(k in (load_scenario(n).get("robot") or {})
                                                      for k in ("drive", "waypoints", "follow"))]

@@ -5,10 +5,10 @@ import hashlib
 import numpy as np
 import pytest
 
-from models.scenario import build_simulation, load_scenario
+from people_tracker.models.scenario import build_simulation, load_scenario
 from tests_helpers import run_cli
-from tracker.io.ground_truth import read_gt_csv
-from tracker.io.recording import Recording
+from people_tracker.tracker.io.ground_truth import read_gt_csv
+from people_tracker.tracker.io.recording import Recording
 
 
 def _digest(folder):

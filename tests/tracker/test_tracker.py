@@ -4,15 +4,15 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
-from models.scenario import build_simulation, load_scenario
-from models.scan import Scan
-from tracker.config import config_from_dict, load_config
-from tracker.evaluation import TrackRows, evaluate
-from tracker.io.ground_truth import GroundTruth
-from tracker.pairing import PairingParams, pair_legs
-from tracker.people_tracker import AssociationParams, PeopleTracker, tracks_in_sensor_frame
-from tracker.tracks import TrackParams, TrackState
-from models.motion import constant_velocity_F, constant_velocity_Q
+from people_tracker.models.scenario import build_simulation, load_scenario
+from people_tracker.models.scan import Scan
+from people_tracker.tracker.config import config_from_dict, load_config
+from people_tracker.tracker.evaluation import TrackRows, evaluate
+from people_tracker.tracker.io.ground_truth import GroundTruth
+from people_tracker.tracker.pairing import PairingParams, pair_legs
+from people_tracker.tracker.people_tracker import AssociationParams, PeopleTracker, tracks_in_sensor_frame
+from people_tracker.tracker.tracks import TrackParams, TrackState
+from people_tracker.models.motion import constant_velocity_F, constant_velocity_Q
 
 
 def run_scene(name, follow=None, config=None, **overrides):
@@ -152,7 +152,7 @@ def test_legs_of_two_people_never_pair_across():
     # 0.43 m apart, each person's own 0.5 m and 0.6 m
     xy = np.array([[2.7, 0.0], [2.7, 0.5], [3.1, 0.35], [3.1, -0.25]])
     sizes = np.full(4, 0.12)
-    from tracker.pairing import owners
+    from people_tracker.tracker.pairing import owners
     groups = owners(xy, np.array([[2.7, 0.25], [3.1, 0.05]]), 0.4)
     assert groups.tolist() == [0, 0, 1, 1]
     pairs = sorted(c.object_ids for c in pair_legs(xy, sizes, [1, 2, 3, 4], p, groups) if c.kind == "pair")
@@ -193,7 +193,7 @@ def test_a_person_held_still_is_not_pulled_away_by_a_distant_moving_candidate():
     trk._tracks = [t]
     for k in range(1, 8):  # coasting: its gate grows far beyond 1 m
         t.predict(0.1 * k)
-    from tracker.pairing import PersonCandidate
+    from people_tracker.tracker.pairing import PersonCandidate
     far = PersonCandidate(1.2, 0.0, 0.1, "leg")
     near = PersonCandidate(0.3, 0.0, 0.1, "leg")
     assert trk._associate([far]) == []

@@ -34,7 +34,7 @@ def test_rrd_holds_scan_labels_tracks_and_truth(tmp_path):
     scan = data["/world/scan"]
     assert sorted(scan["scan"]) == list(range(200))
     # the first scan's readings, all of them valid in this room, with their set labels
-    from tracker.io.simulated import SimulatedSource
+    from people_tracker.tracker.io.simulated import SimulatedSource
     first = next(SimulatedSource("crossing").scans()).scan
     row0 = scan["scan"].index(0)
     assert len(scan["Points2D:positions"][row0]) == first.n_valid

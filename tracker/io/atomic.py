@@ -8,7 +8,7 @@ import tempfile
 from pathlib import Path
 from typing import IO, Iterator
 
-from tracker.errors import InputError
+from people_tracker.tracker.errors import InputError
 
 
 def check_writable(path: str | Path) -> Path:

@@ -16,10 +16,10 @@ from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Writer2
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-from models.pose import Pose2D
-from models.scan import Scan
-from tracker.errors import InputError
-from tracker.io.bag import LASER_SCAN, ODOMETRY, TF_MESSAGE
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.scan import Scan
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.bag import LASER_SCAN, ODOMETRY, TF_MESSAGE
 
 FORMATS = ("mcap", "sqlite3", "ros1")
 

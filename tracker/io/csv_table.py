@@ -15,9 +15,9 @@ def read_rows(path: str | Path, what: str, needed: tuple[str, ...],
     ``convert(row)`` (a dict with every header column) returns ``(scan_index, …)``; it may raise
     ``ValueError``/``TypeError`` for a malformed row. A row whose ``scan_index`` (the first
     value) is negative or whose ``x``/``y`` are not finite is refused too. Every problem
-    raises :class:`~tracker.errors.InputError` naming ``what``, the file and the line.
+    raises :class:`~people_tracker.tracker.errors.InputError` naming ``what``, the file and the line.
     """
-    from tracker.errors import InputError
+    from people_tracker.tracker.errors import InputError
 
     p = Path(path)
     if not p.exists():

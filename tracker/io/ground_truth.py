@@ -13,9 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
-from tracker.errors import InputError
-from tracker.io.bag import LASER_SCAN, PERSON_TYPES, connections_of, open_bag, select_topic, topics_of_type
-from tracker.io.csv_table import read_rows
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.bag import LASER_SCAN, PERSON_TYPES, connections_of, open_bag, select_topic, topics_of_type
+from people_tracker.tracker.io.csv_table import read_rows
 
 log = logging.getLogger(__name__)
 

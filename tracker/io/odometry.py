@@ -22,10 +22,10 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-from models.pose import Pose2D, interpolate_pose, yaw_from_quaternion
-from tracker.config import OdometryConfig
-from tracker.errors import InputError
-from tracker.io.bag import ODOMETRY, TF_MESSAGE, connections_of, peek_stamp, stamp_seconds, topics_of_type
+from people_tracker.models.pose import Pose2D, interpolate_pose, yaw_from_quaternion
+from people_tracker.tracker.config import OdometryConfig
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.bag import ODOMETRY, TF_MESSAGE, connections_of, peek_stamp, stamp_seconds, topics_of_type
 
 log = logging.getLogger(__name__)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import IO
 
-from detection.objects import MovingObject
+from people_tracker.detection.objects import MovingObject
 
 DETECTION_COLUMNS = ("scan_index", "stamp", "object_id", "first_beam", "last_beam", "n_points", "x", "y",
                      "width", "length", "recovered_from")

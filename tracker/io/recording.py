@@ -13,13 +13,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
 
-from models.pose import Pose2D
-from detection.deskew import sweep_duration
-from models.scan import Scan
-from tracker.config import OdometryConfig
-from tracker.errors import InputError
-from tracker.io.bag import LASER_SCAN, connections_of, open_bag, select_topic, stamp_seconds
-from tracker.io.odometry import choose_pose_source
+from people_tracker.models.pose import Pose2D
+from people_tracker.detection.deskew import sweep_duration
+from people_tracker.models.scan import Scan
+from people_tracker.tracker.config import OdometryConfig
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.bag import LASER_SCAN, connections_of, open_bag, select_topic, stamp_seconds
+from people_tracker.tracker.io.odometry import choose_pose_source
 
 log = logging.getLogger(__name__)
 
@@ -92,7 +92,7 @@ class Recording:
     def __init__(self, path: str | Path, topic: str | None = None,
                  odometry: OdometryConfig | None = None) -> None:
         if odometry is None:
-            from tracker.config import load_config
+            from people_tracker.tracker.config import load_config
             odometry = load_config().odometry
         self.path = Path(path)
         self._cfg = odometry

@@ -8,11 +8,11 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from models.scenario import ScenarioError, build_simulation, load_scenario
-from tracker.errors import InputError
-from tracker.io.atomic import atomic_output, check_writable
-from tracker.io.bag_writer import BagWriter
-from tracker.io.recording import ScanRecord
+from people_tracker.models.scenario import ScenarioError, build_simulation, load_scenario
+from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.atomic import atomic_output, check_writable
+from people_tracker.tracker.io.bag_writer import BagWriter
+from people_tracker.tracker.io.recording import ScanRecord
 
 DEFAULT_SCENE = "crossing"
 
@@ -28,7 +28,7 @@ def _load(scenario: str, seed: int | None, people: int | None, duration: float |
 
 
 class SimulatedSource:
-    """A scenario run in memory, read like a :class:`~tracker.io.recording.Recording`.
+    """A scenario run in memory, read like a :class:`~people_tracker.tracker.io.recording.Recording`.
 
     The sensor pose of each scan is the odometry's (drift included) composed with the mount,
     as a recording's would be.

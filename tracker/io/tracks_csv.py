@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tracker.evaluation import TrackRows
-from tracker.io.csv_table import read_rows
+from people_tracker.tracker.evaluation import TrackRows
+from people_tracker.tracker.io.csv_table import read_rows
 
 NEEDED = ("scan_index", "track_id", "x", "y")
 
