@@ -37,9 +37,13 @@ def beam_index(bearing, angle_min: float, angle_increment: float, n_beams: int) 
     centre = 0.5 * (n_beams - 1) * res
     offset = (np.asarray(bearing, dtype=np.float64) - angle_min) * np.sign(angle_increment)
     offset = np.mod(offset - centre + np.pi, TWO_PI) - np.pi + centre
-    idx = np.rint(offset / res).astype(np.int64)
+    step = np.rint(offset / res)
+    idx = np.full(step.shape, -1, dtype=np.int64)
+    inside = np.isfinite(step) & (step > -n_beams) & (step < 2 * n_beams)  # a non-finite bearing is nowhere
+    idx[inside] = step[inside]
     if n_beams * res >= TWO_PI - 0.5 * res:  # a full turn: the ends meet
-        return np.mod(idx, n_beams)
+        idx[inside] = np.mod(idx[inside], n_beams)
+        return idx
     idx[(idx < 0) | (idx >= n_beams)] = -1
     return idx
 
@@ -57,6 +61,12 @@ class Scan:
     ranges : ndarray, shape (n,)
         Measured range of each beam, metres. May hold ``nan``, ``inf`` and ``0``;
         see :attr:`valid`. Stored as a read-only float64 copy.
+
+    Raises
+    ------
+    ValueError
+        When the scan is malformed: ``ranges`` not one-dimensional, ``angle_increment``
+        zero or not finite, any other number not finite.
     angle_min : float
         Bearing of beam 0 in the sensor frame, radians.
     angle_increment : float
@@ -92,6 +102,9 @@ class Scan:
             raise ValueError(f"ranges must be one-dimensional, got shape {ranges.shape}")
         if not np.isfinite(self.angle_increment) or self.angle_increment == 0.0:
             raise ValueError(f"angle_increment must be finite and non-zero, got {self.angle_increment}")
+        for name in ("angle_min", "range_min", "range_max", "stamp", "time_increment"):
+            if not np.isfinite(getattr(self, name)):
+                raise ValueError(f"{name} must be finite, got {getattr(self, name)}")
         ranges.setflags(write=False)
         object.__setattr__(self, "ranges", ranges)
         if self.bearings is not None:

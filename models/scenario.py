@@ -22,11 +22,12 @@ Every key is checked: an unknown one is an error that names it.
 from __future__ import annotations
 
 import math
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import yaml
+
+from people_tracker.configs import names_a_file, shipped_file, shipped_names
 
 from people_tracker.models.laser import LaserModel
 from people_tracker.models.person import PersonModel, Walker
@@ -55,21 +56,26 @@ _KEYS = {
 
 def scenario_names() -> list[str]:
     """Names of the scenarios shipped in ``configs/scenarios``."""
-    folder = resources.files("people_tracker.configs").joinpath("scenarios")
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".yaml"))
+    return shipped_names("scenarios")
 
 
 def load_scenario(name_or_path: str | Path) -> dict:
-    """The scenario mapping for a shipped name or a YAML path (checked, not yet built)."""
-    p = Path(name_or_path)
-    if p.suffix in (".yaml", ".yml") or p.exists():
+    """The scenario mapping for a shipped name, or for a YAML file when the argument ends in
+    ``.yaml``/``.yml`` or holds a path separator (checked, not yet built)."""
+    if names_a_file(name_or_path):
+        p = Path(name_or_path)
         if not p.is_file():
             raise ScenarioError(f"scenario file '{p}' does not exist")
-        text, origin = p.read_text(encoding="utf-8"), f"scenario file '{p}'"
+        try:
+            text = p.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ScenarioError(f"scenario file '{p}' cannot be read: {exc}") from None
+        origin = f"scenario file '{p}'"
     else:
-        f = resources.files("people_tracker.configs").joinpath("scenarios", f"{name_or_path}.yaml")
-        if not f.is_file():
-            raise ScenarioError(f"no scenario '{name_or_path}' (shipped: {', '.join(scenario_names())})")
+        f = shipped_file(str(name_or_path), "scenarios")
+        if f is None:
+            raise ScenarioError(f"no scenario '{name_or_path}' (shipped: {', '.join(scenario_names())}; "
+                                f"a file needs .yaml or a path separator, e.g. ./{name_or_path}.yaml)")
         text, origin = f.read_text(encoding="utf-8"), f"scenario '{name_or_path}'"
     try:
         spec = yaml.safe_load(text)

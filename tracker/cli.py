@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.errors import InputError, require
 
 PROG = "people-tracker"
 
@@ -110,11 +110,17 @@ def _print_v_min(params, resolution: float) -> None:
             f"{v:.2f} m/s at {r:g} m" for v, r in zip(speeds, (1, 3, 5))))
 
 
+def _run_outputs(args) -> list[str]:
+    """Every file ``run`` writes: the CSVs, their resolved configurations and the rerun file."""
+    csvs = [out for out in (args.detections, args.tracks) if out]
+    return csvs + [f"{out}.config.yaml" for out in csvs] + ([args.rrd] if args.rrd else [])
+
+
 def _cmd_run(args) -> int:
     import contextlib
 
     from people_tracker.tracker.config import load_config
-    from people_tracker.tracker.io.atomic import check_writable
+    from people_tracker.tracker.io.atomic import check_outputs
     from people_tracker.tracker.io.recording import Recording
 
     config = load_config(args.config)
@@ -125,9 +131,7 @@ def _cmd_run(args) -> int:
         follow = args.follow if args.follow == "auto" else int(args.follow)
     if args.input is None and args.topic:
         raise InputError("--topic needs an INPUT recording")
-    for out in (args.detections, args.tracks, args.rrd):
-        if out:
-            check_writable(out)
+    check_outputs([args.input, args.config], _run_outputs(args))
     t0 = time.perf_counter()
     truth = _ground_truth_by_scan(args.input, args.topic) if (args.rrd or args.spawn) and args.input else None
     sink = _make_sink(args)
@@ -163,6 +167,7 @@ def _make_sink(args):
 
     if not (args.rrd or args.spawn):
         return NullSink()
+    require("rerun", "viz", "--rrd and --spawn (rerun visualisation)")
     from people_tracker.tracker.viz_rerun import RerunSink
     return RerunSink(args.rrd, args.spawn)
 
@@ -178,6 +183,9 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
     with source as rec, stack:
         det_file = stack.enter_context(atomic_output(args.detections)) if args.detections else None
         trk_file = stack.enter_context(atomic_output(args.tracks)) if args.tracks else None
+        # the resolved configuration beside each CSV, published with it when the run ends
+        sidecars = [stack.enter_context(atomic_output(f"{out}.config.yaml")) for out in (args.detections, args.tracks)
+                    if out]
         if det_file:
             outputs.write_header(det_file)
         if trk_file:
@@ -250,10 +258,8 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
         if tracker.selector is not None:
             events = tracker.selector.events
             print(f"following: {', '.join(events) if events else 'no target found'}")
-        for out in (args.detections, args.tracks):
-            if out:
-                with atomic_output(f"{out}.config.yaml") as fh:
-                    fh.write(dump_config(config))
+        for fh in sidecars:
+            fh.write(dump_config(config))
         if args.rrd:
             print(f"rerun recording: {args.rrd} (open it with: rerun {args.rrd})")
 
@@ -261,8 +267,8 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
 def _cmd_evaluate(args) -> int:
     import json
 
-    from people_tracker.tracker.evaluation import evaluate, format_table
-    from people_tracker.tracker.io.atomic import atomic_output, check_writable
+    from people_tracker.tracker.evaluation import evaluate, format_table, frame_mismatches
+    from people_tracker.tracker.io.atomic import atomic_output, check_outputs
     from people_tracker.tracker.io.ground_truth import read_ground_truth
     from people_tracker.tracker.io.tracks_csv import read_tracks_csv
 
@@ -273,10 +279,11 @@ def _cmd_evaluate(args) -> int:
     window = args.bearing_window
     if window is not None and not (all(math.isfinite(b) and -180 <= b <= 180 for b in window) and window[0] < window[1]):
         raise InputError(f"--bearing-window needs MIN < MAX, both in -180..180 degrees, got {window[0]:g} {window[1]:g}")
-    if args.json:
-        check_writable(args.json)
+    check_outputs([args.tracks, args.ground_truth], [args.json])
     tracks = read_tracks_csv(args.tracks)
     gt = read_ground_truth(args.ground_truth, args.topic, args.gt_topic)
+    for reason in frame_mismatches(gt, tracks):
+        logging.getLogger(PROG).warning(reason)
     result = evaluate(gt, tracks, args.protocol, args.threshold, args.ospa_cutoff, args.ospa_order,
                       bearing_window_deg=None if window is None else tuple(window))
     result["tracks_file"] = str(args.tracks)
@@ -306,6 +313,7 @@ def _cmd_simulate(args) -> int:
 
 
 def _cmd_bench(args) -> int:
+    require("motmetrics", "eval", "people-tracker bench")
     from people_tracker.tracker.bench import run_bench
     from people_tracker.tracker.config import load_config
 

@@ -11,12 +11,12 @@ import dataclasses
 import math
 import typing
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from people_tracker.configs import names_a_file, shipped_file, shipped_names
 from people_tracker.tracker.errors import InputError
 
 
@@ -202,7 +202,7 @@ class Config:
 
 
 def _default_text() -> str:
-    return resources.files("people_tracker.configs").joinpath("default.yaml").read_text(encoding="utf-8")
+    return shipped_file("default").read_text(encoding="utf-8")
 
 
 def _merge(base: dict, override: dict, where: str) -> dict:
@@ -298,9 +298,17 @@ def config_from_dict(overrides: dict | None = None) -> Config:
 
 
 def load_config(path: str | Path | None = None) -> Config:
-    """Load the defaults, overridden by the YAML file at ``path`` when given."""
+    """Load the defaults, overridden by a shipped configuration (a name such as
+    ``moving_robot``) or by the YAML file at ``path`` (it ends in ``.yaml``/``.yml`` or holds
+    a path separator)."""
     if path is None:
         return config_from_dict()
+    if not names_a_file(path):
+        f = shipped_file(str(path))
+        if f is None:
+            raise InputError(f"no shipped configuration '{path}' (shipped: {', '.join(shipped_names())}; "
+                             f"a file needs .yaml or a path separator, e.g. ./{path}.yaml)")
+        return config_from_dict(_parse_yaml(f.read_text(encoding="utf-8"), f"shipped configuration '{path}'"))
     p = Path(path)
     if not p.exists():
         raise InputError(f"configuration file '{p}' does not exist")

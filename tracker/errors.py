@@ -6,3 +6,16 @@ class InputError(Exception):
 
     The message is one line that names the problem; the CLI prints it and exits with 2.
     """
+
+
+def require(module: str, extra: str, feature: str):
+    """Import ``module`` for ``feature``, or say in one line which extra installs it.
+
+    Returns the module; raises :class:`InputError` (exit status 2) when it is missing.
+    """
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise InputError(f"{feature} needs the [{extra}] extra: pip install 'people-tracker[{extra}]'") from None

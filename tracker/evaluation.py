@@ -27,6 +27,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from people_tracker.models.pose import pairwise_distances
+from people_tracker.tracker.errors import require
 from people_tracker.tracker.io.ground_truth import GroundTruth
 
 
@@ -42,6 +43,31 @@ class TrackRows:
 
     def __len__(self) -> int:
         return int(self.scan_index.shape[0])
+
+
+def frame_mismatches(gt: GroundTruth, tracks: TrackRows) -> list[str]:
+    """Reasons to doubt that ``tracks`` and ``gt`` come from one recording, one line each.
+
+    The ground truth's frames are its scans ``0..n-1`` (its last annotated scan when it
+    does not say how many there are); the tracks' frames run from scan 0 (every message
+    of the topic counts) to their last row. Said when the tracks go beyond the ground
+    truth, or when the two overlap on fewer than half of either's frames.
+    """
+    if not len(tracks.scan_index):
+        return []
+    n_gt = gt.n_frames if gt.n_frames is not None else (int(gt.scan_index.max()) + 1 if len(gt.scan_index) else 0)
+    n_tracks = int(tracks.scan_index.max()) + 1
+    out = []
+    if n_tracks > n_gt:
+        out.append(f"the tracks hold scan indices up to {n_tracks - 1}, beyond the ground truth's {n_gt} frames "
+                   f"(0..{n_gt - 1}): are both from the same recording and topic?")
+    overlap = min(n_gt, n_tracks)
+    if overlap < 0.5 * n_gt or overlap < 0.5 * n_tracks:
+        out.append(f"the tracks (scans 0..{n_tracks - 1}) and the ground truth ({n_gt} frames) overlap on "
+                   f"{overlap} frames only, fewer than half of "
+                   + ("either's" if overlap < 0.5 * n_gt and overlap < 0.5 * n_tracks
+                      else "the ground truth's" if overlap < 0.5 * n_gt else "the tracks'"))
+    return out
 
 
 def _by_frame(index: np.ndarray, n_frames: int) -> list[np.ndarray]:
@@ -91,7 +117,8 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
         frames, ground_truth, matches, misses, false_positives, id_switches, mota, motp (m),
         idf1, ospa (m, mean over frames), and the protocol and parameters used.
     """
-    import motmetrics as mm  # imported here: pandas is slow to import and only evaluation needs it
+    # imported here: pandas is slow to import and only evaluation needs it
+    mm = require("motmetrics", "eval", "evaluation (CLEAR MOT, IDF1)")
 
     if protocol not in ("general", "following"):
         raise ValueError(f"protocol must be general or following, got {protocol!r}")

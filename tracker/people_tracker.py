@@ -9,6 +9,8 @@
 
 from __future__ import annotations
 
+import logging
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -102,6 +104,7 @@ class PeopleTracker:
         self._tracks: list[TrackState] = []
         self._next_id = 1
         self.last: StepResult | None = None
+        self.bad_poses = 0  # poses given with a scan that were not finite (the scan was used without)
 
     @classmethod
     def from_config(cls, config, follow: str | int | None = None) -> "PeopleTracker":
@@ -128,6 +131,9 @@ class PeopleTracker:
         pose_last_beam : Pose2D, optional
             Sensor pose from odometry when the last beam fired, for de-skew.
         """
+        pose, pose_last_beam = self._usable(pose, scan.stamp), self._usable(pose_last_beam, scan.stamp)
+        if pose is None:
+            pose_last_beam = None
         people = np.array([t.position for t in self._tracks if t.confirmed]).reshape(-1, 2)
         aligned = self.aligner.align(scan, pose, pose_last_beam, people)  # 0. de-skew and align
         scan, world = aligned.scan, aligned.pose
@@ -154,6 +160,17 @@ class PeopleTracker:
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.confirmed]
         self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing)
         return reported
+
+    def _usable(self, pose: Pose2D | None, stamp: float) -> Pose2D | None:
+        """The pose, or None when it is not finite (counted; the first one is a warning)."""
+        if pose is None or (math.isfinite(pose.x) and math.isfinite(pose.y) and math.isfinite(pose.yaw)):
+            return pose
+        self.bad_poses += 1
+        if self.bad_poses == 1:
+            logging.getLogger("people_tracker").warning(
+                "the pose given with the scan at stamp %.3f s is not finite; such scans are used without a pose "
+                "(PeopleTracker.bad_poses counts them)", stamp)
+        return None
 
     def _candidates(self, detection: Detection, world: Pose2D) -> list[PersonCandidate]:
         objs = detection.objects

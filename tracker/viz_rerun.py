@@ -22,18 +22,70 @@ from __future__ import annotations
 
 import math
 import os
+import socket
+import sys
 import tempfile
+import time
 from collections import defaultdict, deque
 from pathlib import Path
 
 import numpy as np
-import rerun as rr
-import rerun.blueprint as rrb
-import shapely
 
-from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
-from people_tracker.tracker.io.atomic import publish
-from people_tracker.tracker.sinks import Sink
+# rerun's own log lines (coloured, several per failure) would say again what our one line says
+os.environ.setdefault("RUST_LOG", "off")
+
+import rerun as rr  # noqa: E402
+import rerun.blueprint as rrb  # noqa: E402
+import shapely  # noqa: E402
+
+from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW, STATIC  # noqa: E402
+from people_tracker.tracker.io.atomic import OutputError, publish  # noqa: E402
+from people_tracker.tracker.sinks import Sink  # noqa: E402
+
+VIEWER_PORT = 9876  # rerun's default
+VIEWER_START_S = 10.0  # how long the spawned viewer may take to listen
+FLUSH_S = 10.0  # how long closing may wait for the last data to reach the file or the viewer
+
+
+def display_available() -> bool:
+    """Whether a window can open here: on Linux and the BSDs an X11 or Wayland display must
+    be set; macOS and Windows always have one."""
+    if sys.platform.startswith(("linux", "freebsd", "openbsd", "netbsd")):
+        return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    return True
+
+
+def _start_viewer() -> None:
+    """Start the rerun viewer as a process of its own (it outlives the run) and wait until it
+    listens; if it exits first, say why in one line."""
+    import subprocess
+
+    err = tempfile.TemporaryFile()
+    proc = subprocess.Popen([sys.executable, "-m", "rerun_cli", "--port", str(VIEWER_PORT), "--memory-limit", "75%"],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err, start_new_session=True)
+    deadline = time.monotonic() + VIEWER_START_S
+    while not _listening(VIEWER_PORT, 0.0):
+        if proc.poll() is not None or time.monotonic() > deadline:
+            if proc.poll() is None:
+                proc.kill()
+            err.seek(0)
+            lines = [ln for ln in err.read().decode(errors="replace").splitlines() if ln.strip()]
+            why = " ".join(lines[-1].split())[:200] if lines else f"nothing listens on port {VIEWER_PORT}"
+            raise OutputError(f"the rerun viewer did not start ({why}); save the run with --rrd FILE.rrd instead")
+        time.sleep(0.1)
+
+
+def _listening(port: int, timeout_s: float) -> bool:
+    """Whether something accepts connections on localhost ``port`` within ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=0.5):
+                return True
+        except OSError:
+            if time.monotonic() >= deadline:
+                return False
+            time.sleep(0.1)
 
 _SET_COLOURS = [(STATIC, "A static", (150, 150, 150)), (MOVING, "M moving", (230, 40, 40)),
                 (OCCLUDED, "O occluded", (255, 160, 0)), (OUT_OF_VIEW, "N out of view", (60, 110, 255))]
@@ -77,13 +129,16 @@ class RerunSink(Sink):
         self._target = Path(rrd) if rrd else None
         self._tmp = None
         if self._target is not None:
-            fd, tmp = tempfile.mkstemp(prefix=f".{self._target.name}.", suffix=".part",
-                                       dir=self._target.parent if str(self._target.parent) else ".")
+            try:
+                fd, tmp = tempfile.mkstemp(prefix=f".{self._target.name}.", suffix=".part",
+                                           dir=self._target.parent if str(self._target.parent) else ".")
+            except OSError as exc:
+                raise OutputError(f"cannot write output '{self._target}': {exc.strerror or exc}") from None
             os.close(fd)
             self._tmp = Path(tmp)
             self.rec.save(str(self._tmp))
         elif spawn:
-            self.rec.spawn()
+            self._spawn()
         self._trails: dict[int, deque] = defaultdict(lambda: deque(maxlen=_TRAIL))
         self._history: dict[int, list[tuple[float, float]]] = defaultdict(list)  # whole trajectories
         self._path: list[tuple[float, float]] = []
@@ -154,6 +209,17 @@ class RerunSink(Sink):
         rec.log("metrics/people", rr.Scalars(float(len(tracks))))
         rec.log("metrics/latency_ms", rr.Scalars(1e3 * latency_s))
 
+    def _spawn(self) -> None:
+        """Start the viewer (or use one already listening) and stream to it; fail at once,
+        in one line, where none can start, rather than log into the void."""
+        if not display_available():
+            raise OutputError("--spawn needs a display for the rerun viewer and none is set (DISPLAY, "
+                              "WAYLAND_DISPLAY); save the run with --rrd FILE.rrd and open it where there "
+                              "is one with: rerun FILE.rrd")
+        if not _listening(VIEWER_PORT, 0.0):
+            _start_viewer()
+        self.rec.connect_grpc(f"rerun+http://127.0.0.1:{VIEWER_PORT}/proxy")
+
     def close(self) -> None:
         ids = sorted(self._history)
         self.rec.log("world/overview/tracks", rr.LineStrips2D(
@@ -162,15 +228,23 @@ class RerunSink(Sink):
         if self._path:
             self.rec.log("world/overview/robot_path", rr.LineStrips2D([np.array(self._path)], colors=(210, 210, 210),
                                                                      radii=0.03), static=True)
-        self.rec.flush()
-        self.rec.disconnect()
-        if self._tmp is not None:
-            publish(self._tmp, self._target)
-            self._tmp = None
+        try:
+            self.rec.flush(timeout_sec=FLUSH_S)
+            self.rec.disconnect()
+            if self._tmp is not None:
+                publish(self._tmp, self._target)
+                self._tmp = None
+        except Exception as exc:
+            self.abort()
+            what = f"cannot write output '{self._target}'" if self._target else "cannot stream to the rerun viewer"
+            raise OutputError(f"{what}: {' '.join(str(exc).split())[:200]}") from None
 
     def abort(self) -> None:
         try:
+            self.rec.flush(timeout_sec=1.0)  # never wait long for a viewer that is gone
             self.rec.disconnect()
+        except Exception:  # pragma: no cover - the run already failed; leave no file behind
+            pass
         finally:
             if self._tmp is not None and self._tmp.exists():
                 self._tmp.unlink()
