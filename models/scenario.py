@@ -65,7 +65,7 @@ def load_scenario(name_or_path: str | Path) -> dict:
     if names_a_file(name_or_path):
         p = Path(name_or_path)
         if not p.is_file():
-            raise ScenarioError(f"scenario file '{p}' does not exist")
+            raise ScenarioError(f"scenario file '{name_or_path}' does not exist")
         try:
             text = p.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:

@@ -167,6 +167,9 @@ def _make_sink(args):
 
     if not (args.rrd or args.spawn):
         return NullSink()
+    # rerun's own log lines (coloured, several per failure) would repeat what our one line
+    # says; read when rerun is first imported
+    os.environ.setdefault("RUST_LOG", "off")
     require("rerun", "viz", "--rrd and --spawn (rerun visualisation)")
     from people_tracker.tracker.viz_rerun import RerunSink
     return RerunSink(args.rrd, args.spawn)
@@ -272,6 +275,7 @@ def _cmd_evaluate(args) -> int:
     from people_tracker.tracker.io.ground_truth import read_ground_truth
     from people_tracker.tracker.io.tracks_csv import read_tracks_csv
 
+    require("motmetrics", "eval", "people-tracker evaluate")
     for name, value in (("--threshold", args.threshold), ("--ospa-cutoff", args.ospa_cutoff),
                         ("--ospa-order", args.ospa_order)):
         if not (math.isfinite(value) and value > 0):

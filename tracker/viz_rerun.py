@@ -31,16 +31,13 @@ from pathlib import Path
 
 import numpy as np
 
-# rerun's own log lines (coloured, several per failure) would say again what our one line says
-os.environ.setdefault("RUST_LOG", "off")
+import rerun as rr
+import rerun.blueprint as rrb
+import shapely
 
-import rerun as rr  # noqa: E402
-import rerun.blueprint as rrb  # noqa: E402
-import shapely  # noqa: E402
-
-from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW, STATIC  # noqa: E402
-from people_tracker.tracker.io.atomic import OutputError, publish  # noqa: E402
-from people_tracker.tracker.sinks import Sink  # noqa: E402
+from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
+from people_tracker.tracker.io.atomic import OutputError, publish
+from people_tracker.tracker.sinks import Sink
 
 VIEWER_PORT = 9876  # rerun's default
 VIEWER_START_S = 10.0  # how long the spawned viewer may take to listen
