@@ -87,6 +87,17 @@ def _build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--duration", type=float, metavar="S", help="override the scenario's duration, seconds")
     sim.add_argument("--format", choices=("mcap", "sqlite3", "ros1"), default="mcap",
                      help="ROS 2 bag storage (mcap, sqlite3) or a ROS 1 .bag (default: mcap)")
+    tl = sub.add_parser("train-legs", help="fit the leg model to your own laser's recordings ([train] extra)")
+    tl.add_argument("--positive", nargs="+", required=True, metavar="BAG[:TOPIC]",
+                    help="recordings with people's legs: labelled in --label-topic, or inside --box")
+    tl.add_argument("--negative", nargs="+", required=True, metavar="BAG[:TOPIC]",
+                    help="recordings where nobody is (every LaserScan topic, or the one after ':')")
+    tl.add_argument("--output", required=True, metavar="MODEL.npz", help="the model file to write")
+    tl.add_argument("--label-topic", default="/leg_cluster_positions", metavar="TOPIC",
+                    help="geometry_msgs/PoseArray of leg centres in the sensor frame (default: %(default)s)")
+    tl.add_argument("--box", type=float, nargs=4, metavar=("X0", "Y0", "X1", "Y1"),
+                    help="no labels: every candidate inside this box (sensor frame, m) is a leg")
+    tl.add_argument("--trees", type=int, default=200, help="boosting rounds (%(default)s)")
     bench = sub.add_parser("bench", help="accuracy and speed on every recording and simulated scene")
     bench.add_argument("--data", metavar="DIR", help="folder of recordings (default: $PEOPLE_TRACKER_DATA, "
                        "else ../shared/data)")
@@ -329,6 +340,52 @@ def _cmd_bench(args) -> int:
     return 0
 
 
+def _bag_and_topic(arg: str) -> tuple[str, str | None]:
+    """``BAG`` or ``BAG:TOPIC``."""
+    if not Path(arg).exists() and ":" in arg:
+        bag, topic = arg.rsplit(":", 1)
+        return bag, topic
+    return arg, None
+
+
+def _cmd_train_legs(args) -> int:
+    from people_tracker.tracker import train_legs as T
+    from people_tracker.tracker.io.atomic import atomic_output, check_outputs
+
+    require("sklearn", "train", "people-tracker train-legs")
+    if args.box is not None and not (args.box[0] < args.box[2] and args.box[1] < args.box[3]):
+        raise InputError("--box needs X0 < X1 and Y0 < Y1 (sensor frame, metres)")
+    if not 10 <= args.trees <= 5000:
+        raise InputError("--trees must be between 10 and 5000")
+    inputs = [_bag_and_topic(a) for a in args.positive + args.negative]
+    check_outputs([b for b, _ in inputs], [args.output])
+    t0 = time.perf_counter()
+    positives, negatives, names = [], [], []
+    for arg in args.positive:
+        bag, topic = _bag_and_topic(arg)
+        positives.append(T.read_labelled(bag, topic, args.label_topic, tuple(args.box) if args.box else None))
+        names.append(f"{bag}{':' + topic if topic else ''}")
+    for arg in args.negative:
+        bag, topic = _bag_and_topic(arg)
+        for t in ([topic] if topic else T.laser_topics(bag)):
+            negatives.append([s for _, s in T.read_scans(bag, t)])
+            names.append(f"{bag}:{t}")
+    moved = T.transplanted(positives, negatives, per_scan=2)
+    x, y, groups = T.dataset(positives, negatives)
+    xm, ym, gm = T.dataset(moved, [])
+    recorded = np.concatenate([np.ones(len(y), dtype=bool), np.zeros(len(ym), dtype=bool)])
+    x, y, groups = np.vstack([x, xm]), np.concatenate([y, ym]), np.concatenate([groups, gm])
+    print(f"candidates: {int(y.sum())} legs, {int(len(y) - y.sum())} others (each scan also at every 2nd and 3rd "
+          f"beam), from {sum(map(len, positives))} labelled scans, their legs pasted into "
+          f"{sum(map(len, moved))} empty ones, and {sum(map(len, negatives))} empty scans")
+    model = T.fit(x, y, groups, n_trees=args.trees, meta={"trained_on": names}, calibrate_on=recorded)
+    with atomic_output(args.output, "wb") as fh:
+        model.save(fh)
+    print(f"wrote {args.output} ({len(model.feature)} trees of depth {model.depth}, "
+          f"{model.meta['calibration']}) in {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``people-tracker`` console script; returns the exit status."""
     argv = sys.argv[1:] if argv is None else argv
@@ -338,7 +395,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
     _setup_logging(args.quiet)
-    commands = {"run": _cmd_run, "evaluate": _cmd_evaluate, "simulate": _cmd_simulate, "bench": _cmd_bench}
+    commands = {"run": _cmd_run, "evaluate": _cmd_evaluate, "simulate": _cmd_simulate, "bench": _cmd_bench,
+                "train-legs": _cmd_train_legs}
     try:
         return commands[args.command](args)
     except InputError as exc:

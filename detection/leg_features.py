@@ -1,0 +1,209 @@
+"""Leg candidates of one scan and their shape, in metres: what a leg looks like to a laser.
+
+Every run of consecutive readings closer than ``max(gap_m, gap_beams · r · res)`` to the
+next is a candidate (Leigh et al. cluster at 0.13 m; the beam-spacing term keeps a far leg
+of a coarse scanner in one piece). Its features describe the shape in metric,
+scanner-independent terms, so a model trained on one laser holds on another: how wide it
+is, how well a circle fits it and of what radius, how straight it is, how it bulges
+towards the sensor, how far the readings beside it lie behind it or in front, and how
+many readings it has compared with what the beam spacing gives at its range. Nothing here
+looks at motion or at earlier scans: the score is about shape alone.
+
+Every feature is symmetric in beam order (a clockwise laser gives the same values), and
+computed for all candidates of a scan at once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from people_tracker.models.scan import Scan
+
+FEATURES = (
+    "n_rel",               # readings / (readings the beam spacing gives over the width at that range)
+    "width_m",             # first to last reading
+    "range_m",             # sensor to the readings' mean
+    "spread_m",            # RMS distance of the readings from their mean
+    "circle_radius_m",     # radius of the least-squares circle (1 m for a straight line)
+    "circle_residual_m",   # RMS distance of the readings from that circle
+    "line_residual_m",     # RMS distance from the best straight line
+    "boundary_m",          # length of the polyline through the readings
+    "boundary_ratio",      # boundary / width: 1 for a straight run, more for a curve or a zigzag
+    "bulge_m",             # mean distance of the readings from the chord, towards the sensor
+    "centre_depth_m",      # how far the circle's centre lies behind the readings (a round leg: its radius)
+    "jump_near_m",         # range step to the readings just outside, the smaller of the two ends ...
+    "jump_far_m",          # ... and the larger (3 m: nothing there; -2 m: a lost reading, unknown)
+    "gap_near_m",          # distance to the nearest reading outside, either end (3 m: none)
+    # what the laser sees beside the candidate, 0.1, 0.2, 0.3 and 0.5 m beyond each edge at
+    # its range: the range there minus the candidate's, the nearer and the farther side
+    "side_0.1_near_m", "side_0.1_far_m", "side_0.2_near_m", "side_0.2_far_m",
+    "side_0.3_near_m", "side_0.3_far_m", "side_0.5_near_m", "side_0.5_far_m",
+)
+SIDE_OFFSETS_M = (0.1, 0.2, 0.3, 0.5)
+NO_RETURN_M = 3.0  # what a beam beside the candidate that saw nothing counts as
+UNKNOWN_M = -2.0  # a lost reading (nan, 0) beside the candidate, or the edge of the view
+
+
+@dataclass(frozen=True, eq=False)
+class LegCandidates:
+    """The candidate segments of one scan.
+
+    Attributes
+    ----------
+    first_beam, last_beam : ndarray of int, shape (k,)
+        Beam span of each candidate in the scan's ``ranges``.
+    start, stop : ndarray of int, shape (k,)
+        The same as indices into the scan's valid readings (stop exclusive).
+    xy : ndarray, shape (k, 2)
+        Mean of each candidate's readings, sensor frame, metres.
+    features : ndarray, shape (k, len(FEATURES))
+    """
+
+    first_beam: np.ndarray
+    last_beam: np.ndarray
+    start: np.ndarray
+    stop: np.ndarray
+    xy: np.ndarray
+    features: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.xy)
+
+
+def _empty() -> LegCandidates:
+    z = np.zeros(0, dtype=np.int64)
+    return LegCandidates(z, z, z, z, np.zeros((0, 2)), np.zeros((0, len(FEATURES))))
+
+
+def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_points: int = 2,
+                   max_width_m: float = 0.45) -> LegCandidates:
+    """Candidate segments of ``scan`` and their features.
+
+    Parameters
+    ----------
+    scan : Scan
+    gap_m, gap_beams : float
+        Consecutive readings belong to one candidate when closer than ``gap_m`` metres or
+        ``gap_beams`` beam spacings at their range (the larger).
+    min_points : int
+        Fewest readings of a candidate.
+    max_width_m : float
+        Wider runs (walls, furniture sides) are no candidates.
+    """
+    beams = np.flatnonzero(scan.valid)
+    if len(beams) < min_points:
+        return _empty()
+    pts = scan.points[beams]
+    r = scan.ranges[beams]
+    res = scan.resolution
+    step = np.hypot(*np.diff(pts, axis=0).T)
+    limit = np.maximum(gap_m, gap_beams * res * np.maximum(r[:-1], r[1:]))
+    bounds = np.concatenate([[0], np.flatnonzero(step >= limit) + 1, [len(pts)]])
+    start, stop = bounds[:-1], bounds[1:]
+    n = stop - start
+    width = np.hypot(*(pts[stop - 1] - pts[start]).T)
+    keep = (n >= min_points) & (width <= max_width_m)
+    if not keep.any():
+        return _empty()
+    # per-segment sums over all runs (reduceat needs them contiguous), then the kept ones
+    sums = lambda a: np.add.reduceat(a, start, axis=0)  # noqa: E731
+    mean = sums(pts) / n[:, None]
+    seg = np.repeat(np.arange(len(start)), n)
+    u = pts - mean[seg]  # readings about their segment's mean
+    suu, svv, suv = sums(u[:, 0] ** 2), sums(u[:, 1] ** 2), sums(u[:, 0] * u[:, 1])
+    q = u[:, 0] ** 2 + u[:, 1] ** 2
+    suq, svq = sums(u[:, 0] * q), sums(u[:, 1] * q)
+    # circle (Kåsa): centre c = (a, b) about the mean solves [suu suv; suv svv] c = ½ [suq; svq]
+    det = suu * svv - suv ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = 0.5 * (svv * suq - suv * svq) / det
+        b = 0.5 * (suu * svq - suv * suq) / det
+        radius = np.sqrt(a ** 2 + b ** 2 + (suu + svv) / n)
+    straight = ~np.isfinite(radius) | (radius > 1.0) | (n < 3)
+    radius = np.where(straight, 1.0, radius)
+    a, b = np.where(straight, 0.0, a), np.where(straight, 0.0, b)
+    d_circle = np.hypot(u[:, 0] - a[seg], u[:, 1] - b[seg]) - radius[seg]
+    circle_residual = np.where(straight, 0.0, np.sqrt(sums(d_circle ** 2) / n))
+    # straight line: the smaller eigenvalue of the scatter, λ = tr/2 - sqrt(tr²/4 - det)
+    tr = suu + svv
+    lam_min = np.maximum(0.5 * tr - np.sqrt(np.maximum(0.25 * tr ** 2 - det, 0.0)), 0.0)
+    line_residual = np.sqrt(lam_min / n)
+    spread = np.sqrt(tr / n)
+    inner = np.concatenate([step, [0.0]])
+    inner[stop - 1] = 0.0  # the step out of a segment is not part of its boundary
+    boundary = sums(inner)
+    # bulge: signed distance from the chord, positive on the sensor's side
+    chord = pts[stop - 1] - pts[start]
+    normal = np.column_stack([-chord[:, 1], chord[:, 0]]) / np.maximum(width, 1e-9)[:, None]
+    towards = np.sign(np.einsum("ij,ij->i", normal, -pts[start]))  # the normal's side the sensor is on
+    towards[towards == 0] = 1.0
+    off = np.einsum("ij,ij->i", pts - pts[start][seg], normal[seg]) * towards[seg]
+    bulge = sums(off) / n
+    rng = np.hypot(mean[:, 0], mean[:, 1])
+    centre_depth = np.where(straight, 0.0, np.hypot(mean[:, 0] + a, mean[:, 1] + b) - rng)
+    first, last = beams[start], beams[stop - 1]
+    j_first, g_first = _beside(scan, first, -1, pts[start], r[start])
+    j_last, g_last = _beside(scan, last, +1, pts[stop - 1], r[stop - 1])
+    expected = width / np.maximum(rng * res, 1e-6) + 1.0
+    sides = _sides(scan, mean, rng, width)
+    features = np.column_stack([
+        n / expected, width, rng, spread, radius, circle_residual, line_residual, boundary,
+        boundary / np.maximum(width, 1e-3), bulge, centre_depth,
+        np.minimum(j_first, j_last), np.maximum(j_first, j_last), np.minimum(g_first, g_last), sides])
+    k = np.flatnonzero(keep)
+    return LegCandidates(first[k], last[k], start[k], stop[k], mean[k], features[k])
+
+
+def _sides(scan: Scan, mean: np.ndarray, rng: np.ndarray, width: np.ndarray) -> np.ndarray:
+    """For each offset of SIDE_OFFSETS_M: the range the laser measured that far beyond each
+    edge of the candidate (across the line of sight, at its range) minus the candidate's
+    range, clipped to -1..3 m (3 m: no return; -2 m: lost, or outside the view), as the
+    smaller and the larger of the two sides. Shape (k, 2 * len(SIDE_OFFSETS_M))."""
+    bearing = np.arctan2(mean[:, 1], mean[:, 0])
+    out = []
+    for offset in SIDE_OFFSETS_M:
+        values = []
+        for side in (-1.0, 1.0):
+            beam = scan.beam_of(bearing + side * (0.5 * width + offset) / np.maximum(rng, 0.05))
+            inside = beam >= 0
+            v = np.full(len(beam), UNKNOWN_M)
+            todo = inside.copy()
+            for shift in (0, -1, 1, -2, 2):  # a lost reading there: the nearest real one beside it
+                b = np.clip(beam + shift, 0, scan.n_beams - 1)
+                ok = todo & scan.valid[b]
+                v[ok] = np.clip(scan.ranges[b[ok]] - rng[ok], -1.0, NO_RETURN_M)
+                free = todo & ~ok & scan.no_return[b]
+                v[free] = NO_RETURN_M
+                todo &= ~(ok | free)
+            values.append(v)
+        out += [np.minimum(*values), np.maximum(*values)]
+    return np.column_stack(out) if out else np.zeros((len(mean), 0))
+
+
+def _beside(scan: Scan, beam: np.ndarray, side: int, end_xy: np.ndarray, end_r: np.ndarray,
+            lateral_m: float = 0.3, max_beams: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    """Range step and distance from each candidate end to the first reading beside it on
+    ``side`` (-1 before, +1 after in beam order), looking as far as ``lateral_m`` across at
+    the end's range (``max_beams`` at most): a valid reading gives its range minus the
+    end's (clipped to -1..3 m) and its distance; a beam that saw nothing, 3 m and none;
+    only lost readings (nan, 0) or the view's edge, unknown."""
+    n = scan.n_beams
+    reach = np.clip(np.ceil(lateral_m / np.maximum(end_r * scan.resolution, 1e-6)), 1, max_beams).astype(np.int64)
+    jump = np.full(len(beam), UNKNOWN_M)
+    gap = np.full(len(beam), NO_RETURN_M)
+    open_ = np.ones(len(beam), dtype=bool)  # still looking
+    for k in range(1, int(reach.max(initial=1)) + 1):
+        j = beam + side * k
+        inside = open_ & (j >= 0) & (j < n) & (k <= reach)
+        if not inside.any():
+            break
+        jj = np.clip(j, 0, n - 1)
+        valid = inside & scan.valid[jj]
+        free = inside & scan.no_return[jj] & ~valid
+        jump[valid] = np.clip(scan.ranges[jj[valid]] - end_r[valid], -1.0, NO_RETURN_M)
+        gap[valid] = np.hypot(*(scan.points[jj[valid]] - end_xy[valid]).T)
+        jump[free] = NO_RETURN_M
+        open_ &= ~(valid | free)
+    return jump, np.minimum(gap, NO_RETURN_M)

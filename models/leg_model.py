@@ -1,0 +1,124 @@
+"""The leg model: a calibrated probability that a scan segment is a person's leg, from its shape.
+
+A gradient-boosted ensemble of small regression trees over the metric features of
+:mod:`people_tracker.detection.leg_features`, fitted by ``people-tracker train-legs`` (scikit-learn,
+the ``[train]`` extra) and stored as plain arrays in a ``.npz`` file; here it is evaluated
+in numpy alone, every tree at once, one gather per tree level. The ensemble's log-odds go
+through an isotonic calibration map fitted on held-out folds, so the score is a
+probability: of the candidates scored about 0.7, about 70 % are legs (for the mix of
+people and empty rooms it was fitted on).
+
+The shipped model (``leg_model.npz`` beside this file) was fitted on Leigh et al.'s
+labelled legs (``positive_{1,2,3}_extracted``) and the empty rooms of ``negative_2.bag``
+(``/left_scan``, ``/right_scan``), each scan also at every 2nd and 3rd beam, so the model
+sees coarser lasers too.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+SHIPPED = "leg_model.npz"
+
+
+@dataclass(frozen=True, eq=False)
+class LegModel:
+    """A tree ensemble and its calibration.
+
+    Attributes
+    ----------
+    feature_names : tuple of str
+        The features each column of the input holds, in order.
+    feature, threshold, left, right, value : ndarray, shape (n_trees, n_nodes)
+        Each tree's nodes: split feature and threshold (go left when ``x <= threshold``),
+        children, and the leaf's contribution to the log-odds (learning rate included).
+        Leaves are their own children, so a walk of ``depth`` steps ends on one.
+    depth : int
+    init : float
+        Log-odds before the first tree.
+    calib_raw, calib_p : ndarray, shape (m,)
+        The calibration map: log-odds (increasing) to probability, linear between.
+    meta : dict
+        What the model was fitted on.
+    """
+
+    feature_names: tuple[str, ...]
+    feature: np.ndarray
+    threshold: np.ndarray
+    left: np.ndarray
+    right: np.ndarray
+    value: np.ndarray
+    depth: int
+    init: float
+    calib_raw: np.ndarray
+    calib_p: np.ndarray
+    meta: dict
+
+    def log_odds(self, x: np.ndarray) -> np.ndarray:
+        """The ensemble's raw score of each row of ``x`` (shape (k, n_features)), shape (k,)."""
+        x = np.asarray(x, dtype=np.float64)
+        k, n_trees = len(x), len(self.feature)
+        if k == 0:
+            return np.zeros(0)
+        trees = np.arange(n_trees)[None, :]
+        rows = np.arange(k)[:, None]
+        node = np.zeros((k, n_trees), dtype=np.int64)
+        for _ in range(self.depth):
+            f = self.feature[trees, node]
+            go_left = x[rows, f] <= self.threshold[trees, node]
+            node = np.where(go_left, self.left[trees, node], self.right[trees, node])
+        return self.init + self.value[trees, node].sum(axis=1)
+
+    def probability(self, x: np.ndarray) -> np.ndarray:
+        """Calibrated probability that each row of ``x`` is a leg, shape (k,)."""
+        return np.interp(self.log_odds(x), self.calib_raw, self.calib_p)
+
+    def save(self, target) -> None:
+        """Write the model to ``target``: a path (``.npz``) or a binary file object."""
+        if isinstance(target, (str, Path)):
+            with open(target, "wb") as fh:
+                return self.save(fh)
+        np.savez_compressed(target, feature_names=np.array(self.feature_names), feature=self.feature,
+                                threshold=self.threshold, left=self.left, right=self.right, value=self.value,
+                                depth=self.depth, init=self.init, calib_raw=self.calib_raw, calib_p=self.calib_p,
+                                meta=json.dumps(self.meta))
+        return None
+
+
+class LegModelError(ValueError):
+    """A model file that cannot be used."""
+
+
+def load_leg_model(path: str | Path | None = None) -> LegModel:
+    """The model at ``path``, or the shipped one (``None`` or ``"default"``).
+
+    Raises :class:`LegModelError` (a ``ValueError``) naming the problem for a missing or
+    malformed file.
+    """
+    if path is None or str(path) == "default":
+        source = resources.files(__package__).joinpath(SHIPPED)
+        where = "the shipped leg model"
+    else:
+        source = Path(path)
+        where = f"leg model '{path}'"
+        if not source.is_file():
+            raise LegModelError(f"{where} does not exist")
+    try:
+        with source.open("rb") as fh, np.load(fh, allow_pickle=False) as z:
+            model = LegModel(tuple(str(s) for s in z["feature_names"]), z["feature"].astype(np.int64),
+                             z["threshold"].astype(np.float64), z["left"].astype(np.int64),
+                             z["right"].astype(np.int64), z["value"].astype(np.float64), int(z["depth"]),
+                             float(z["init"]), z["calib_raw"].astype(np.float64), z["calib_p"].astype(np.float64),
+                             json.loads(str(z["meta"])))
+    except (OSError, KeyError, ValueError) as exc:
+        raise LegModelError(f"{where} cannot be read: {' '.join(str(exc).split())[:150]}") from None
+    shapes = {a.shape for a in (model.feature, model.threshold, model.left, model.right, model.value)}
+    if len(shapes) != 1 or model.feature.ndim != 2 or len(model.calib_raw) != len(model.calib_p) \
+            or len(model.calib_raw) < 2 or model.feature.max(initial=0) >= len(model.feature_names):
+        raise LegModelError(f"{where} is malformed")
+    return model
