@@ -34,7 +34,7 @@ FEATURES = (
     "bulge_m",             # mean distance of the readings from the chord, towards the sensor
     "centre_depth_m",      # how far the circle's centre lies behind the readings (a round leg: its radius)
     "jump_near_m",         # range step to the readings just outside, the smaller of the two ends ...
-    "jump_far_m",          # ... and the larger (3 m: nothing there; -2 m: a lost reading, unknown)
+    "jump_far_m",          # ... and the larger (3 m: nothing measured there)
     "gap_near_m",          # distance to the nearest reading outside, either end (3 m: none)
     # what the laser sees beside the candidate, 0.1, 0.2, 0.3 and 0.5 m beyond each edge at
     # its range: the range there minus the candidate's, the nearer and the farther side
@@ -42,8 +42,12 @@ FEATURES = (
     "side_0.3_near_m", "side_0.3_far_m", "side_0.5_near_m", "side_0.5_far_m",
 )
 SIDE_OFFSETS_M = (0.1, 0.2, 0.3, 0.5)
-NO_RETURN_M = 3.0  # what a beam beside the candidate that saw nothing counts as
-UNKNOWN_M = -2.0  # a lost reading (nan, 0) beside the candidate, or the edge of the view
+# What a place beside a candidate where the laser measured nothing counts as. Drivers say
+# "no echo" in different ways (inf, range_max, 0, nan: Leigh et al.'s Hokuyo gives 0, the
+# annotated hallway recording inf), so the features do not tell them apart: a model that
+# did learned one driver's convention and failed on the other.
+NO_RETURN_M = 3.0
+UNKNOWN_M = NO_RETURN_M
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,13 +105,22 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     step = np.hypot(*np.diff(pts, axis=0).T)
     limit = np.maximum(gap_m, gap_beams * res * np.maximum(r[:-1], r[1:]))
     bounds = np.concatenate([[0], np.flatnonzero(step >= limit) + 1, [len(pts)]])
-    start, stop = bounds[:-1], bounds[1:]
-    n = stop - start
-    width = np.hypot(*(pts[stop - 1] - pts[start]).T)
-    keep = (n >= min_points) & (width <= max_width_m)
-    if not keep.any():
+    run_start, run_stop = bounds[:-1], bounds[1:]
+    run_n = run_stop - run_start
+    width = np.hypot(*(pts[run_stop - 1] - pts[run_start]).T)
+    k = np.flatnonzero((run_n >= min_points) & (width <= max_width_m))
+    if not len(k):
         return _empty()
-    # per-segment sums over all runs (reduceat needs them contiguous), then the kept ones
+    # only the kept runs' readings from here on, packed one run after another
+    n, width = run_n[k], width[k]
+    first, last = beams[run_start[k]], beams[run_stop[k] - 1]
+    valid_start = run_start[k]  # into the scan's valid readings
+    start = np.concatenate([[0], np.cumsum(n)[:-1]])
+    stop = start + n
+    take = np.repeat(valid_start - start, n) + np.arange(int(n.sum()))
+    pts, r = pts[take], r[take]
+    inner = np.concatenate([step, [0.0]])[take]
+    inner[stop - 1] = 0.0  # the step out of a segment is not part of its boundary
     sums = lambda a: np.add.reduceat(a, start, axis=0)  # noqa: E731
     mean = sums(pts) / n[:, None]
     seg = np.repeat(np.arange(len(start)), n)
@@ -131,8 +144,6 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     lam_min = np.maximum(0.5 * tr - np.sqrt(np.maximum(0.25 * tr ** 2 - det, 0.0)), 0.0)
     line_residual = np.sqrt(lam_min / n)
     spread = np.sqrt(tr / n)
-    inner = np.concatenate([step, [0.0]])
-    inner[stop - 1] = 0.0  # the step out of a segment is not part of its boundary
     boundary = sums(inner)
     # bulge: signed distance from the chord, positive on the sensor's side
     chord = pts[stop - 1] - pts[start]
@@ -143,43 +154,39 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     bulge = sums(off) / n
     rng = np.hypot(mean[:, 0], mean[:, 1])
     centre_depth = np.where(straight, 0.0, np.hypot(mean[:, 0] + a, mean[:, 1] + b) - rng)
-    first, last = beams[start], beams[stop - 1]
-    j_first, g_first = _beside(scan, first, -1, pts[start], r[start])
-    j_last, g_last = _beside(scan, last, +1, pts[stop - 1], r[stop - 1])
+    s0, s1 = start, stop - 1
+    j_first, g_first = _beside(scan, first, -1, pts[s0], r[s0])
+    j_last, g_last = _beside(scan, last, +1, pts[s1], r[s1])
     expected = width / np.maximum(rng * res, 1e-6) + 1.0
-    sides = _sides(scan, mean, rng, width)
     features = np.column_stack([
         n / expected, width, rng, spread, radius, circle_residual, line_residual, boundary,
         boundary / np.maximum(width, 1e-3), bulge, centre_depth,
-        np.minimum(j_first, j_last), np.maximum(j_first, j_last), np.minimum(g_first, g_last), sides])
-    k = np.flatnonzero(keep)
-    return LegCandidates(first[k], last[k], start[k], stop[k], mean[k], features[k])
+        np.minimum(j_first, j_last), np.maximum(j_first, j_last), np.minimum(g_first, g_last),
+        _sides(scan, mean, rng, width)])
+    return LegCandidates(first, last, valid_start, valid_start + n, mean, features)
 
 
 def _sides(scan: Scan, mean: np.ndarray, rng: np.ndarray, width: np.ndarray) -> np.ndarray:
     """For each offset of SIDE_OFFSETS_M: the range the laser measured that far beyond each
     edge of the candidate (across the line of sight, at its range) minus the candidate's
-    range, clipped to -1..3 m (3 m: no return; -2 m: lost, or outside the view), as the
+    range, clipped to -1..3 m (3 m: nothing measured there, or outside the view), as the
     smaller and the larger of the two sides. Shape (k, 2 * len(SIDE_OFFSETS_M))."""
-    bearing = np.arctan2(mean[:, 1], mean[:, 0])
-    out = []
-    for offset in SIDE_OFFSETS_M:
-        values = []
-        for side in (-1.0, 1.0):
-            beam = scan.beam_of(bearing + side * (0.5 * width + offset) / np.maximum(rng, 0.05))
-            inside = beam >= 0
-            v = np.full(len(beam), UNKNOWN_M)
-            todo = inside.copy()
-            for shift in (0, -1, 1, -2, 2):  # a lost reading there: the nearest real one beside it
-                b = np.clip(beam + shift, 0, scan.n_beams - 1)
-                ok = todo & scan.valid[b]
-                v[ok] = np.clip(scan.ranges[b[ok]] - rng[ok], -1.0, NO_RETURN_M)
-                free = todo & ~ok & scan.no_return[b]
-                v[free] = NO_RETURN_M
-                todo &= ~(ok | free)
-            values.append(v)
-        out += [np.minimum(*values), np.maximum(*values)]
-    return np.column_stack(out) if out else np.zeros((len(mean), 0))
+    if not SIDE_OFFSETS_M or not len(mean):
+        return np.zeros((len(mean), 2 * len(SIDE_OFFSETS_M)))
+    offsets = np.array(SIDE_OFFSETS_M)
+    across = (0.5 * width[:, None] + offsets[None, :]) / np.maximum(rng, 0.05)[:, None]  # (k, m) radians
+    bearing = np.arctan2(mean[:, 1], mean[:, 0])[:, None]
+    beam = scan.beam_of(np.concatenate([bearing - across, bearing + across], axis=1))  # (k, 2m)
+    # the reading there, or the nearest real one within two beams of it (lost readings)
+    shifts = np.array([0, -1, 1, -2, 2])
+    cand = np.clip(beam[:, :, None] + shifts, 0, scan.n_beams - 1)  # (k, 2m, 5)
+    real = scan.valid[cand] & (beam[:, :, None] >= 0)
+    pick = np.take_along_axis(cand, np.argmax(real, axis=2)[:, :, None], axis=2)[:, :, 0]
+    value = np.minimum(np.maximum(scan.ranges[pick] - rng[:, None], -1.0), NO_RETURN_M)
+    value = np.where(real.any(axis=2), value, NO_RETURN_M)
+    m = len(offsets)
+    lo, hi = np.minimum(value[:, :m], value[:, m:]), np.maximum(value[:, :m], value[:, m:])
+    return np.column_stack([lo, hi]).reshape(len(mean), 2, m).transpose(0, 2, 1).reshape(len(mean), 2 * m)
 
 
 def _beside(scan: Scan, beam: np.ndarray, side: int, end_xy: np.ndarray, end_r: np.ndarray,
@@ -187,23 +194,18 @@ def _beside(scan: Scan, beam: np.ndarray, side: int, end_xy: np.ndarray, end_r: 
     """Range step and distance from each candidate end to the first reading beside it on
     ``side`` (-1 before, +1 after in beam order), looking as far as ``lateral_m`` across at
     the end's range (``max_beams`` at most): a valid reading gives its range minus the
-    end's (clipped to -1..3 m) and its distance; a beam that saw nothing, 3 m and none;
-    only lost readings (nan, 0) or the view's edge, unknown."""
-    n = scan.n_beams
-    reach = np.clip(np.ceil(lateral_m / np.maximum(end_r * scan.resolution, 1e-6)), 1, max_beams).astype(np.int64)
-    jump = np.full(len(beam), UNKNOWN_M)
-    gap = np.full(len(beam), NO_RETURN_M)
-    open_ = np.ones(len(beam), dtype=bool)  # still looking
-    for k in range(1, int(reach.max(initial=1)) + 1):
-        j = beam + side * k
-        inside = open_ & (j >= 0) & (j < n) & (k <= reach)
-        if not inside.any():
-            break
-        jj = np.clip(j, 0, n - 1)
-        valid = inside & scan.valid[jj]
-        free = inside & scan.no_return[jj] & ~valid
-        jump[valid] = np.clip(scan.ranges[jj[valid]] - end_r[valid], -1.0, NO_RETURN_M)
-        gap[valid] = np.hypot(*(scan.points[jj[valid]] - end_xy[valid]).T)
-        jump[free] = NO_RETURN_M
-        open_ &= ~(valid | free)
+    end's (clipped to -1..3 m) and its distance; none (no echo, however the driver says
+    it, or the view's edge), 3 m and none."""
+    if not len(beam):
+        return np.zeros(0), np.zeros(0)
+    reach = np.minimum(np.maximum(np.ceil(lateral_m / np.maximum(end_r * scan.resolution, 1e-6)), 1), max_beams)
+    steps = np.arange(1, max_beams + 1)
+    j = beam[:, None] + side * steps  # (k, max_beams)
+    inside = (j >= 0) & (j < scan.n_beams) & (steps[None, :] <= reach[:, None])
+    jj = np.clip(j, 0, scan.n_beams - 1)
+    real = inside & scan.valid[jj]
+    found = real.any(axis=1)
+    first = jj[np.arange(len(beam)), np.argmax(real, axis=1)]
+    jump = np.where(found, np.minimum(np.maximum(scan.ranges[first] - end_r, -1.0), NO_RETURN_M), NO_RETURN_M)
+    gap = np.where(found, np.hypot(*(scan.points[first] - end_xy).T), NO_RETURN_M)
     return jump, np.minimum(gap, NO_RETURN_M)

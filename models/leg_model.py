@@ -59,20 +59,26 @@ class LegModel:
     calib_p: np.ndarray
     meta: dict
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_heap", _complete_trees(self))
+
     def log_odds(self, x: np.ndarray) -> np.ndarray:
         """The ensemble's raw score of each row of ``x`` (shape (k, n_features)), shape (k,)."""
         x = np.asarray(x, dtype=np.float64)
-        k, n_trees = len(x), len(self.feature)
-        if k == 0:
+        if len(x) == 0:
             return np.zeros(0)
-        trees = np.arange(n_trees)[None, :]
-        rows = np.arange(k)[:, None]
-        node = np.zeros((k, n_trees), dtype=np.int64)
+        feature, threshold, leaves = self._heap  # complete trees in heap order: children 2i+1, 2i+2
+        n_trees = len(feature)
+        base = (np.arange(n_trees) * feature.shape[1])[None, :]
+        rows = (np.arange(len(x)) * x.shape[1])[:, None]
+        flat_f, flat_t, flat_x = feature.ravel(), threshold.ravel(), x.ravel()
+        node = np.zeros((len(x), n_trees), dtype=np.int64)
         for _ in range(self.depth):
-            f = self.feature[trees, node]
-            go_left = x[rows, f] <= self.threshold[trees, node]
-            node = np.where(go_left, self.left[trees, node], self.right[trees, node])
-        return self.init + self.value[trees, node].sum(axis=1)
+            at = base + node
+            # go right when x > threshold: child 2i + 2, else 2i + 1
+            node = 2 * node + 1 + (flat_x[rows + flat_f[at]] > flat_t[at])
+        leaf = node - (feature.shape[1])  # leaves follow the inner nodes
+        return self.init + leaves.ravel()[(np.arange(n_trees) * leaves.shape[1])[None, :] + leaf].sum(axis=1)
 
     def probability(self, x: np.ndarray) -> np.ndarray:
         """Calibrated probability that each row of ``x`` is a leg, shape (k,)."""
@@ -88,6 +94,35 @@ class LegModel:
                                 depth=self.depth, init=self.init, calib_raw=self.calib_raw, calib_p=self.calib_p,
                                 meta=json.dumps(self.meta))
         return None
+
+
+def _complete_trees(model: LegModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every tree as a complete binary tree of ``depth`` levels in heap order: split
+    features and thresholds of the ``2**depth - 1`` inner nodes, and the ``2**depth`` leaf
+    values. A leaf above the last level becomes nodes that always go left (threshold
+    +inf) down to copies of its value."""
+    d = model.depth
+    n_inner = 2 ** d - 1
+    feature = np.zeros((len(model.feature), n_inner), dtype=np.int64)
+    threshold = np.full((len(model.feature), n_inner), np.inf)
+    leaves = np.zeros((len(model.feature), 2 ** d))
+    for t in range(len(model.feature)):
+        stack = [(0, 0, 0)]  # (node in the model's tree, place in the heap, level)
+        while stack:
+            node, h, level = stack.pop()
+            is_leaf = model.left[t, node] == node
+            if level == d:
+                if not is_leaf:
+                    raise ValueError(f"tree {t} is deeper than the model's depth {d}")
+                leaves[t, h - n_inner] = model.value[t, node]
+                continue
+            if is_leaf:
+                stack += [(node, 2 * h + 1, level + 1), (node, 2 * h + 2, level + 1)]
+            else:
+                feature[t, h] = model.feature[t, node]
+                threshold[t, h] = model.threshold[t, node]
+                stack += [(model.left[t, node], 2 * h + 1, level + 1), (model.right[t, node], 2 * h + 2, level + 1)]
+    return feature, threshold, leaves
 
 
 class LegModelError(ValueError):
@@ -115,9 +150,10 @@ def load_leg_model(path: str | Path | None = None) -> LegModel:
                              z["right"].astype(np.int64), z["value"].astype(np.float64), int(z["depth"]),
                              float(z["init"]), z["calib_raw"].astype(np.float64), z["calib_p"].astype(np.float64),
                              json.loads(str(z["meta"])))
-    except (OSError, KeyError, ValueError) as exc:
+    except (OSError, KeyError, ValueError, IndexError) as exc:
         raise LegModelError(f"{where} cannot be read: {' '.join(str(exc).split())[:150]}") from None
     shapes = {a.shape for a in (model.feature, model.threshold, model.left, model.right, model.value)}
+    # (a tree deeper than its stated depth fails when the model is built: ValueError above)
     if len(shapes) != 1 or model.feature.ndim != 2 or len(model.calib_raw) != len(model.calib_p) \
             or len(model.calib_raw) < 2 or model.feature.max(initial=0) >= len(model.feature_names):
         raise LegModelError(f"{where} is malformed")

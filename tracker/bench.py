@@ -6,8 +6,8 @@ table gives:
 
 * accuracy where ground truth exists: CLEAR MOT by Leigh et al.'s protocol (0.75 m) and
   IDF1, through the same code as ``people-tracker evaluate``; for recordings without
-  annotations, the confirmed tracks per minute (on ``negative_2.bag`` nobody is there, so
-  every one is false);
+  annotations, the confirmed tracks per minute and how many of them were reported for 2 s
+  or more (on ``negative_2.bag`` nobody is there, so every one is false);
 * speed: scans per second and p50/p99 milliseconds per scan (reading and tracking for a
   recording; tracking only for a simulated scene, whose rendering is not timed), and the
   process's peak resident memory so far.
@@ -33,6 +33,7 @@ from people_tracker.tracker.io.simulated import SimulatedSource
 from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 from people_tracker.tracker.scan_checks import ScanChecker
 
+LASTING_S = 2.0  # a false person reported this long is one a user would act on
 LEIGH_WINDOW_DEG = (-80.0, 12.0)  # the bearings Leigh et al. scored on the moving-robot recordings
 SCENES = ("crossing", "stop_and_go", "occlusion", "following", "corridor", "crowd")
 PUBLISHED = ("Published (Leigh et al., ICRA 2015, moving robot, pooled with a second bag): Joint Leg Tracker "
@@ -47,6 +48,7 @@ class Row:
     seconds: list[float]
     result: dict | None = None
     tracks_per_min: float | None = None
+    lasting: int | None = None  # confirmed tracks reported over 2 s or more (first to last stamp)
 
 
 def _run(source, config: Config, timed_read: bool, limit: int | None):
@@ -54,6 +56,7 @@ def _run(source, config: Config, timed_read: bool, limit: int | None):
     tracker = PeopleTracker.from_config(config)
     checker = ScanChecker(config.scan_checks.stamp_jump_periods, config.scan_checks.beam_count_confirm)
     rows, times, ids = [], [], set()
+    seen: dict[int, list[float]] = {}  # track id -> first and last stamp it was reported
     first = last = None
     t_prev = time.perf_counter()
     for n, record in enumerate(source.scans()):
@@ -68,12 +71,14 @@ def _run(source, config: Config, timed_read: bool, limit: int | None):
             for t, (x, y) in zip(tracks, tracks_in_sensor_frame(tracks, tracker.last.pose)):
                 rows.append((record.index, t.track_id, x, y))
                 ids.add(t.track_id)
+                seen.setdefault(t.track_id, [record.scan.stamp, record.scan.stamp])[1] = record.scan.stamp
             first = record.scan.stamp if first is None else first
             last = record.scan.stamp
         t_prev = time.perf_counter()
         times.append(t_prev - t0)
     span = (last - first) if first is not None and last is not None else 0.0
-    return rows, times, ids, span
+    lasting = sum(b - a >= LASTING_S for a, b in seen.values())
+    return rows, times, ids, span, lasting
 
 
 def _track_rows(rows) -> TrackRows:
@@ -84,8 +89,8 @@ def _track_rows(rows) -> TrackRows:
 def bench_recording(path: Path, topic: str, config: Config, limit: int | None) -> list[Row]:
     """The recording's row; for an annotated one, also its score in Leigh et al.'s bearing window."""
     with Recording(path, topic, config.odometry) as rec:
-        rows, times, ids, span = _run(rec, config, timed_read=True, limit=limit)
-    row = Row(f"{path.name} {topic}", len(times), times)
+        rows, times, ids, span, lasting = _run(rec, config, timed_read=True, limit=limit)
+    row = Row(f"{path.name} {topic}", len(times), times, lasting=lasting)
     gt = read_bag_ground_truth(path, topic, required=False)
     if gt is not None:
         if limit is not None:
@@ -102,7 +107,7 @@ def bench_recording(path: Path, topic: str, config: Config, limit: int | None) -
 
 def bench_scene(name: str, config: Config, duration: float | None) -> Row:
     source = SimulatedSource(name, duration=duration)
-    rows, times, ids, span = _run(source, config, timed_read=False, limit=None)
+    rows, times, ids, span, _ = _run(source, config, timed_read=False, limit=None)
     gt_rows = [(i, p, x, y) for i, tr in enumerate(source.truths)
                for p, (x, y) in zip(tr.person_id[tr.visible], tr.torso_sensor[tr.visible])]
     g = np.array(gt_rows, dtype=float).reshape(-1, 4)
@@ -137,12 +142,14 @@ def format_row(row: Row) -> str:
         acc = (f"{num(100 * r['mota'], 8, '.1f')} {num(r['motp_m'], 6, '.3f')} {r['id_switches']:>5} {r['misses']:>6} "
                f"{r['false_positives']:>6} {num(100 * r['idf1'], 6, '.1f')} {'':>8}")
     else:
-        acc = f"{'':>8} {'':>6} {'':>5} {'':>6} {'':>6} {'':>6} {row.tracks_per_min:>8.1f}"
+        acc = f"{'':>8} {'':>6} {'':>5} {'':>6} {'':>6} {'':>6} {row.tracks_per_min:>8.1f} {row.lasting:>5}"
+        return f"{row.name:<48} {row.scans:>5} {acc} {speed}"
+    acc += f" {'':>5}"
     return f"{row.name:<48} {row.scans:>5} {acc} {speed}"
 
 
 HEADER = (f"{'input':<48} {'scans':>5} {'MOTA %':>8} {'MOTP m':>6} {'IDsw':>5} {'misses':>6} {'FP':>6} "
-          f"{'IDF1 %':>6} {'trk/min':>8} {'scans/s':>7} {'p50 ms':>7} {'p99 ms':>7} {'MiB':>6}")
+          f"{'IDF1 %':>6} {'trk/min':>8} {'>=2s':>5} {'scans/s':>7} {'p50 ms':>7} {'p99 ms':>7} {'MiB':>6}")
 
 
 def machine() -> str:

@@ -60,6 +60,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
     run.add_argument("--detections", metavar="FILE.csv", help="write the moving objects of every scan")
     run.add_argument("--tracks", metavar="FILE.csv", help="write the confirmed people of every scan")
+    run.add_argument("--legs", metavar="FILE.csv", help="write every leg candidate of every scan with its probability")
     run.add_argument("--follow", metavar="auto|ID", help="follow a person: the closest ahead (auto) or a track id")
     run.add_argument("--rrd", metavar="FILE.rrd", help="save a rerun recording of every stage")
     run.add_argument("--spawn", action="store_true", help="open the rerun viewer and stream to it")
@@ -123,7 +124,7 @@ def _print_v_min(params, resolution: float) -> None:
 
 def _run_outputs(args) -> list[str]:
     """Every file ``run`` writes: the CSVs, their resolved configurations and the rerun file."""
-    csvs = [out for out in (args.detections, args.tracks) if out]
+    csvs = [out for out in (args.detections, args.tracks, args.legs) if out]
     return csvs + [f"{out}.config.yaml" for out in csvs] + ([args.rrd] if args.rrd else [])
 
 
@@ -197,13 +198,16 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
     with source as rec, stack:
         det_file = stack.enter_context(atomic_output(args.detections)) if args.detections else None
         trk_file = stack.enter_context(atomic_output(args.tracks)) if args.tracks else None
+        leg_file = stack.enter_context(atomic_output(args.legs)) if args.legs else None
         # the resolved configuration beside each CSV, published with it when the run ends
-        sidecars = [stack.enter_context(atomic_output(f"{out}.config.yaml")) for out in (args.detections, args.tracks)
-                    if out]
+        sidecars = [stack.enter_context(atomic_output(f"{out}.config.yaml"))
+                    for out in (args.detections, args.tracks, args.legs) if out]
         if det_file:
             outputs.write_header(det_file)
         if trk_file:
             outputs.write_tracks_header(trk_file)
+        if leg_file:
+            outputs.write_legs_header(leg_file)
         tracker = PeopleTracker.from_config(config, follow)
         _print_v_min(tracker.detector.params, rec.resolution)
         checker = ScanChecker(config.scan_checks.stamp_jump_periods, config.scan_checks.beam_count_confirm)
@@ -246,6 +250,10 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
                 if trk_file:
                     outputs.write_track_rows(trk_file, record.index, scan.stamp, tracks,
                                              tracks_in_sensor_frame(tracks, tracker.last.pose))
+                if leg_file:
+                    last = tracker.last
+                    outputs.write_leg_rows(leg_file, record.index, scan.stamp, last.scan.valid_points, last.legs,
+                                           last.leg_scores)
                 first_stamp = scan.stamp if first_stamp is None else first_stamp
                 last_stamp = scan.stamp
                 if record.pose is not None:

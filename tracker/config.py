@@ -138,10 +138,7 @@ class StandingConfig:
     """Standing people found by leg shape; see :class:`people_tracker.tracker.standing.StandingParams`."""
 
     enabled: bool = field(metadata=_spec())
-    min_points: int = field(metadata=_spec(lo=1, hi=10000))
-    max_leg_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
-    edge_jump_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
-    max_range_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
+    min_leg_probability: float = field(metadata=_spec(lo=0.0, hi=1.0))
     min_leg_separation_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
     max_leg_separation_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
     confirm_scans: int = field(metadata=_spec(lo=1, hi=1000))
@@ -152,6 +149,21 @@ class StandingConfig:
     def params(self):
         from people_tracker.tracker.standing import StandingParams
         return _params_of(self, StandingParams)
+
+
+@dataclass(frozen=True)
+class LegsConfig:
+    """The leg model; see :mod:`people_tracker.models.leg_model`."""
+
+    model: str = field(metadata=_spec())
+
+    def load(self):
+        """The leg model this configuration names, or :class:`InputError` saying why not."""
+        from people_tracker.models.leg_model import LegModelError, load_leg_model
+        try:
+            return load_leg_model(self.model)
+        except LegModelError as exc:
+            raise InputError(f"configuration key 'legs.model': {exc}") from None
 
 
 @dataclass(frozen=True)
@@ -191,6 +203,7 @@ class Config:
     tracks: TracksConfig
     association: AssociationConfig
     standing: StandingConfig
+    legs: LegsConfig
     alignment: AlignmentConfig
 
     def to_dict(self) -> dict:

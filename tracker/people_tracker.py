@@ -18,7 +18,8 @@ import numpy as np
 from people_tracker.detection.align import Alignment, AlignParams, ScanAligner
 from people_tracker.detection.detector import Detection, DetectorParams, MovingObjectDetector
 from people_tracker.detection.free_space import seen_through
-from people_tracker.detection.legs import free_standing_legs
+from people_tracker.detection.leg_features import LegCandidates, leg_candidates
+from people_tracker.models.leg_model import LegModel, load_leg_model
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
 from people_tracker.tracker.association import associate, mahalanobis_costs
@@ -78,6 +79,8 @@ class StepResult:
     scan: Scan  # as the detector saw it (de-skewed)
     alignment: Alignment
     standing: list[PersonCandidate] = ()  # leg pairs found by shape (world frame)
+    legs: LegCandidates | None = None  # every leg candidate of the scan (sensor frame) ...
+    leg_scores: np.ndarray | None = None  # ... and the leg model's probability for each
 
 
 class PeopleTracker:
@@ -93,7 +96,7 @@ class PeopleTracker:
     def __init__(self, detector: DetectorParams | None = None, pairing: PairingParams | None = None,
                  tracks: TrackParams | None = None, association: AssociationParams | None = None,
                  follow: str | int | None = None, alignment: AlignParams | None = None,
-                 standing: StandingParams | None = None) -> None:
+                 standing: StandingParams | None = None, leg_model: LegModel | None = None) -> None:
         self.aligner = ScanAligner(alignment or AlignParams())
         self.detector = MovingObjectDetector(detector or DetectorParams())
         self.pairing = pairing or PairingParams()
@@ -101,6 +104,7 @@ class PeopleTracker:
         self.assoc = association or AssociationParams()
         self.selector = TargetSelector(follow) if follow is not None else None
         self.standing = StandingInitiator(standing or StandingParams())
+        self.leg_model = leg_model if leg_model is not None else load_leg_model()
         self._tracks: list[TrackState] = []
         self._next_id = 1
         self.last: StepResult | None = None
@@ -110,7 +114,8 @@ class PeopleTracker:
     def from_config(cls, config, follow: str | int | None = None) -> "PeopleTracker":
         """A tracker from a resolved :class:`people_tracker.tracker.config.Config`."""
         return cls(config.detector.params(), config.pairing.params(), config.tracks.params(),
-                   config.association.params(), follow, config.alignment.params(), config.standing.params())
+                   config.association.params(), follow, config.alignment.params(), config.standing.params(),
+                   config.legs.load())
 
     def reset(self) -> None:
         """Forget the scan history (a stamp jump, a new scanner); tracks coast on."""
@@ -148,7 +153,9 @@ class PeopleTracker:
         for ti, ci in matched:  # 5. update the matched tracks
             c = candidates[ci]
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
-        standing = self._standing_candidates(scan, world)  # 6. standing people, found by leg shape
+        legs = leg_candidates(scan)  # 6. every leg candidate and its probability, by shape alone
+        leg_scores = self.leg_model.probability(legs.features)
+        standing = self._standing_candidates(legs, leg_scores, world)  # 6b. standing people: leg pairs
         matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
         self._support(scan, world, matched_t)  # 7. static support for the rest
         for t in self._tracks:
@@ -158,7 +165,7 @@ class PeopleTracker:
         self._delete(scan.stamp)  # 9. delete what the lifecycle rules end
         target = self._follow(world, scan.stamp)  # 10. the followed person
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.confirmed]
-        self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing)
+        self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing, legs, leg_scores)
         return reported
 
     def _usable(self, pose: Pose2D | None, stamp: float) -> Pose2D | None:
@@ -235,14 +242,11 @@ class PeopleTracker:
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
                 t.update(z, R, moving=False)
 
-    def _standing_candidates(self, scan: Scan, world: Pose2D) -> list[PersonCandidate]:
+    def _standing_candidates(self, legs: LegCandidates, scores: np.ndarray, world: Pose2D) -> list[PersonCandidate]:
         p = self.standing.params
         if not p.enabled:
             return []
-        d = self.detector.params
-        legs = free_standing_legs(scan, d.k_segment, d.segment_floor_m, p.min_points, self.pairing.min_leg_size_m,
-                                  p.max_leg_size_m, p.edge_jump_m, p.max_range_m)
-        mids = standing_pairs(legs, p)
+        mids = standing_pairs(legs.xy[scores >= p.min_leg_probability], p)
         xy = world.transform_points(mids) if len(mids) else mids
         return [PersonCandidate(float(x), float(y), self.pairing.sigma_pair_m, "standing") for x, y in xy]
 

@@ -2,8 +2,8 @@
 
 Someone who stands still never moves, so motion detection (the paper's method) never
 reports them; on the annotated hallway recording most of the people are standing. Their
-legs still look like legs: two free-standing leg-shaped segments (see
-:func:`people_tracker.detection.legs.free_standing_legs`) a stance apart. Such a pair starts a track
+legs still look like legs: two segments the leg model (:mod:`people_tracker.models.leg_model`) finds
+more likely legs than not, a stance apart. Such a pair starts a track
 only when it comes back at the same place in the world in most of the last few scans (a
 one-off coincidence of two unrelated segments does not), never near an existing track,
 and never where a standing track was already ended as furniture: a standing track that
@@ -29,17 +29,8 @@ class StandingParams:
     ----------
     enabled : bool
         Look for standing people at all.
-    min_points : int
-        Fewest readings of a leg.
-    max_leg_size_m : float
-        Longest chord of a standing leg, metres: narrower than a moving leg's limit, which
-        also covers a leg blurred by its own swing; at 30–40 cm above the floor a leg shows
-        5–15 cm, while furniture sides and boxes run longer.
-    edge_jump_m : float
-        A leg stands free: the beams beside it return nothing or something at least this
-        much farther, metres.
-    max_range_m : float
-        Legs farther than this have too few readings to judge, metres.
+    min_leg_probability : float
+        A segment is a standing leg when the leg model gives it at least this probability.
     min_leg_separation_m, max_leg_separation_m : float
         Distance between the two legs of a standing person, metres.
     confirm_scans, confirm_window : int
@@ -52,10 +43,7 @@ class StandingParams:
     """
 
     enabled: bool = True
-    min_points: int = 3
-    max_leg_size_m: float = 0.18
-    edge_jump_m: float = 0.3
-    max_range_m: float = 6.0
+    min_leg_probability: float = 0.25
     min_leg_separation_m: float = 0.1
     max_leg_separation_m: float = 0.5
     confirm_scans: int = 3
