@@ -8,10 +8,12 @@ through an isotonic calibration map fitted on held-out folds, so the score is a
 probability: of the candidates scored about 0.7, about 70 % are legs (for the mix of
 people and empty rooms it was fitted on).
 
-The shipped model (``leg_model.npz`` beside this file) was fitted on Leigh et al.'s
-labelled legs (``positive_{1,2,3}_extracted``) and the empty rooms of ``negative_2.bag``
-(``/left_scan``, ``/right_scan``), each scan also at every 2nd and 3rd beam, so the model
-sees coarser lasers too.
+The shipped model (``leg_model.npz`` beside this file) was fitted with
+``people-tracker train-legs`` on Leigh et al.'s labelled legs (``positive_{1,2,3}_extracted``,
+also pasted into the empty rooms), the empty rooms of ``negative_2.bag`` (``/left_scan``,
+``/right_scan``) and 600 scans of simulated furnished rooms with people, each scan also at
+every 2nd and 3rd beam, so the model sees other rooms, other legs and coarser lasers too;
+its calibration map is fitted on the recorded examples alone.
 """
 
 from __future__ import annotations

@@ -99,6 +99,8 @@ def _build_parser() -> argparse.ArgumentParser:
     tl.add_argument("--box", type=float, nargs=4, metavar=("X0", "Y0", "X1", "Y1"),
                     help="no labels: every candidate inside this box (sensor frame, m) is a leg")
     tl.add_argument("--trees", type=int, default=200, help="boosting rounds (%(default)s)")
+    tl.add_argument("--simulated", type=int, default=600, metavar="N",
+                    help="also N scans of simulated rooms with people and furniture, every leg known (%(default)s; 0: none)")
     bench = sub.add_parser("bench", help="accuracy and speed on every recording and simulated scene")
     bench.add_argument("--data", metavar="DIR", help="folder of recordings (default: $PEOPLE_TRACKER_DATA, "
                        "else ../shared/data)")
@@ -365,6 +367,8 @@ def _cmd_train_legs(args) -> int:
         raise InputError("--box needs X0 < X1 and Y0 < Y1 (sensor frame, metres)")
     if not 10 <= args.trees <= 5000:
         raise InputError("--trees must be between 10 and 5000")
+    if not 0 <= args.simulated <= 100000:
+        raise InputError("--simulated must be between 0 and 100000")
     inputs = [_bag_and_topic(a) for a in args.positive + args.negative]
     check_outputs([b for b, _ in inputs], [args.output])
     t0 = time.perf_counter()
@@ -381,11 +385,14 @@ def _cmd_train_legs(args) -> int:
     moved = T.transplanted(positives, negatives, per_scan=2)
     x, y, groups = T.dataset(positives, negatives)
     xm, ym, gm = T.dataset(moved, [])
-    recorded = np.concatenate([np.ones(len(y), dtype=bool), np.zeros(len(ym), dtype=bool)])
-    x, y, groups = np.vstack([x, xm]), np.concatenate([y, ym]), np.concatenate([groups, gm])
+    xs, ys, gs = T.dataset([T.simulated_rooms(args.simulated)] if args.simulated else [], [])
+    gs = gs + (int(groups.max(initial=0)) + 1) * T.BLOCKS  # groups of their own
+    recorded = np.concatenate([np.ones(len(y), dtype=bool), np.zeros(len(ym) + len(ys), dtype=bool)])
+    x, y, groups = np.vstack([x, xm, xs]), np.concatenate([y, ym, ys]), np.concatenate([groups, gm, gs])
     print(f"candidates: {int(y.sum())} legs, {int(len(y) - y.sum())} others (each scan also at every 2nd and 3rd "
           f"beam), from {sum(map(len, positives))} labelled scans, their legs pasted into "
-          f"{sum(map(len, moved))} empty ones, and {sum(map(len, negatives))} empty scans")
+          f"{sum(map(len, moved))} empty ones, {sum(map(len, negatives))} empty scans and {args.simulated} "
+          f"simulated ones")
     model = T.fit(x, y, groups, n_trees=args.trees, meta={"trained_on": names}, calibrate_on=recorded)
     with atomic_output(args.output, "wb") as fh:
         model.save(fh)

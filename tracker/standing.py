@@ -43,7 +43,7 @@ class StandingParams:
     """
 
     enabled: bool = True
-    min_leg_probability: float = 0.25
+    min_leg_probability: float = 0.3
     min_leg_separation_m: float = 0.1
     max_leg_separation_m: float = 0.5
     confirm_scans: int = 3

@@ -16,6 +16,12 @@ simulated ones. Each labelled scan's legs are therefore also pasted, with their 
 readings, into two empty rooms of the negative recordings (:func:`transplant`), where the
 room lies behind them.
 
+Recorded legs come from a few people in one place; ``--simulated`` scans of randomised
+furnished rooms with people (:func:`simulated_rooms`, every leg known, so every other
+candidate is a negative) show the model other leg sizes, rooms and lasers. The
+calibration map is fitted on the recorded examples alone, so the share of legs it learns
+is the recordings'.
+
 Every scan is also used at every 2nd and every 3rd beam (each offset), so the model learns
 what a leg looks like to coarser lasers and needs no retraining for them. The ensemble
 (scikit-learn's ``GradientBoostingClassifier``) is calibrated with an isotonic map fitted
@@ -46,11 +52,13 @@ BLOCKS = 5  # each recording is cut into this many stretches of time; a fold lea
 @dataclass(frozen=True, eq=False)
 class LabelledScan:
     """A scan and the legs labelled in it (sensor frame, metres, shape (m, 2)), or the box
-    (x0, y0, x1, y1) inside which every candidate is a leg."""
+    (x0, y0, x1, y1) inside which every candidate is a leg. ``complete``: every leg of the
+    scan is labelled (a simulated one), so the other candidates are not legs."""
 
     scan: Scan
     legs: np.ndarray | None = None
     box: tuple[float, float, float, float] | None = None
+    complete: bool = False
 
 
 def decimate(scan: Scan, every: int, offset: int = 0) -> Scan:
@@ -185,6 +193,61 @@ def transplanted(labelled: list[list[LabelledScan]], rooms: list[list[Scan]], pe
     return out
 
 
+def simulated_rooms(n_scans: int, seed: int = 100, resolutions_deg=(0.25, 0.35, 0.5, 0.75)) -> list[LabelledScan]:
+    """Scans of randomised furnished rooms with people, every leg labelled.
+
+    A new room every 10 scans: walls 6-14 by 5-12 m, two to eight tables and chairs whose
+    legs are 1.2-3.5 cm in radius, a 270-degree laser of one of ``resolutions_deg`` with
+    0.5-2 cm of noise; in each scan one to six people 0.7-6 m away, standing or mid-stride,
+    legs 4.5-8.5 cm in radius and 10-30 cm apart. A leg is labelled when two or more
+    readings fall on it. Recorded legs come from a few people in one place; these show
+    the model other leg sizes, other rooms and other lasers."""
+    import math
+
+    from people_tracker.models.laser import LaserModel
+    from people_tracker.models.pose import Pose2D
+    from people_tracker.models.world import build_world
+
+    rng = np.random.default_rng(seed)
+    out = []
+    world = furniture = laser = None
+    for k in range(n_scans):
+        if k % 10 == 0:
+            w, h = rng.uniform(6, 14), rng.uniform(5, 12)
+            x0, y0 = -rng.uniform(1, 3), -h / 2
+            world = build_world({"room": [x0, y0, x0 + w, y0 + h]})
+            legs_ = []
+            for _ in range(rng.integers(2, 9)):
+                cx, cy = rng.uniform(x0 + 0.5, x0 + w - 0.5), rng.uniform(y0 + 0.5, y0 + h - 0.5)
+                ww, dd, r = rng.uniform(0.35, 1.6), rng.uniform(0.35, 1.0), rng.uniform(0.012, 0.035)
+                legs_ += [(cx + sx * ww / 2, cy + sy * dd / 2, r) for sx in (-1, 1) for sy in (-1, 1)]
+            furniture = np.array(legs_)
+            laser = LaserModel(fov=math.radians(270), resolution=math.radians(float(rng.choice(resolutions_deg))),
+                               range_max=20.0, noise_std=rng.uniform(0.005, 0.02))
+        people: list[np.ndarray] = []
+        for _ in range(rng.integers(1, 7)):
+            for _ in range(50):  # a free place
+                r, a = rng.uniform(0.7, 6.0), rng.uniform(-2.2, 2.2)
+                c = np.array([r * math.cos(a), r * math.sin(a)])
+                if (np.hypot(*(furniture[:, :2] - c).T).min() > 0.5
+                        and all(np.hypot(*(c - q)) > 0.6 for q in people)):
+                    people.append(c)
+                    break
+        legs = []
+        for c in people:
+            heading, stride, spacing = rng.uniform(-math.pi, math.pi), rng.uniform(0, 0.4), rng.uniform(0.1, 0.3)
+            radius = rng.uniform(0.045, 0.085)
+            along = np.array([math.cos(heading), math.sin(heading)])
+            across = np.array([-along[1], along[0]])
+            legs += [(*(c + s * stride * along + s * spacing * across), radius) for s in (-0.5, 0.5)]
+        legs = np.array(legs).reshape(-1, 3)
+        scan, hit = laser.render(0.0, Pose2D(), world.segments, np.vstack([world.circles, furniture, legs]), rng)
+        first = len(world.segments) + len(world.circles) + len(furniture)
+        seen = np.bincount(hit[scan.valid & (hit >= first)] - first, minlength=len(legs))
+        out.append(LabelledScan(scan, legs[seen >= 2, :2], complete=True))
+    return out
+
+
 def dataset(labelled: list[list[LabelledScan]], negatives: list[list[Scan]], match_radius_m: float = 0.15,
             decimations=DECIMATIONS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Features, labels (1 leg, 0 not) and group of every candidate used for training, each
@@ -203,9 +266,9 @@ def dataset(labelled: list[list[LabelledScan]], negatives: list[list[Scan]], mat
                     keep = pos
                 else:
                     pos, _ = match(c.xy, item.legs, match_radius_m)
-                    keep = pos
+                    keep = np.ones(len(c), dtype=bool) if item.complete else pos
                 xs.append(c.features[keep])
-                ys.append(np.ones(int(keep.sum())))
+                ys.append(pos[keep].astype(float))
                 gs.append(np.full(int(keep.sum()), group))
     for g, recording in enumerate(negatives, start=len(labelled)):
         for k, scan in enumerate(recording):

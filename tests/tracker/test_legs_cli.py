@@ -47,7 +47,7 @@ def test_train_legs_fits_a_model_that_run_can_use(tmp_path):
     pytest.importorskip("sklearn", reason="scikit-learn is the [train] extra")
     pos = data_file("leigh/training/positive_2_extracted.bag")
     neg = data_file("leigh/negative_2.bag")
-    proc = run_cli("train-legs", "--positive", str(pos), "--negative", f"{neg}:/left_scan", "--output", "mine.npz",
+    proc = run_cli("train-legs", "--positive", str(pos), "--negative", f"{neg}:/left_scan", "--output", "mine.npz", "--simulated", "50",
                    "--trees", "30", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert "wrote mine.npz" in proc.stdout and "legs" in proc.stdout
@@ -66,7 +66,7 @@ def test_train_legs_with_a_box_instead_of_labels(tmp_path):
     pos = data_file("leigh/training/positive_2.bag")  # the raw recording: no labels
     neg = data_file("leigh/negative_2.bag")
     proc = run_cli("train-legs", "--positive", str(pos), "--negative", f"{neg}:/rear_scan", "--box", "0.5", "-0.7",
-                   "5.0", "0.25", "--output", "boxed.npz", "--trees", "20", cwd=tmp_path)
+                   "5.0", "0.25", "--output", "boxed.npz", "--trees", "20", "--simulated", "0", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "boxed.npz").exists()
 

