@@ -32,3 +32,13 @@ def moving_bag() -> Path:
 @pytest.fixture
 def negative_bag() -> Path:
     return data_file("leigh/negative_2.bag")
+
+
+@pytest.fixture(scope="session")
+def small_bag(tmp_path_factory) -> Path:
+    """A small synthetic ROS 2 bag (MCAP, 10 scans with odometry), written once per run."""
+    from tests_helpers import bagmaker
+
+    p = tmp_path_factory.mktemp("bags") / "small"
+    bagmaker.write_bag(p, "mcap", n_scans=10)
+    return p

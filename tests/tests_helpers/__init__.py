@@ -18,3 +18,17 @@ def run_cli(*args: str, cwd: Path | None = None, env: dict | None = None, **kwar
     """Run the installed ``people-tracker`` command as a user would."""
     return subprocess.run(cli_command() + list(args), capture_output=True, text=True, cwd=cwd, env=env,
                           timeout=300, **kwargs)
+
+
+def assert_one_line_error(proc: subprocess.CompletedProcess, *words: str, before_work: bool = True) -> None:
+    """The contract for bad input: exit status 2, one line on stderr naming the problem (with
+    each of ``words``), no traceback; nothing on stdout when it is found ``before_work``
+    (a disk that fills up is found mid-run, after the run has begun to report)."""
+    assert proc.returncode == 2, (proc.returncode, proc.stderr)
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("people-tracker: error: "), proc.stderr
+    assert "Traceback" not in proc.stderr
+    for w in words:
+        assert w in lines[0], lines[0]
+    if before_work:
+        assert proc.stdout == ""

@@ -4,25 +4,13 @@ import shutil
 
 import pytest
 
-from tests_helpers import bagmaker, run_cli
+from tests_helpers import assert_one_line_error, bagmaker, run_cli
 from conftest import data_file
 
 
-def assert_one_line_error(proc, *words):
-    assert proc.returncode == 2, proc.stderr
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1, proc.stderr
-    assert "Traceback" not in proc.stderr and lines[0].startswith("people-tracker: error: ")
-    for w in words:
-        assert w in lines[0], lines[0]
-    assert proc.stdout == ""
-
-
-@pytest.fixture(scope="module")
-def good_bag(tmp_path_factory):
-    p = tmp_path_factory.mktemp("bags") / "good"
-    bagmaker.write_bag(p, "mcap", n_scans=10)
-    return p
+@pytest.fixture
+def good_bag(small_bag):
+    return small_bag
 
 
 def test_missing_input(tmp_path):
