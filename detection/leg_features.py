@@ -47,7 +47,6 @@ SIDE_OFFSETS_M = (0.1, 0.2, 0.3, 0.5)
 # annotated hallway recording inf), so the features do not tell them apart: a model that
 # did learned one driver's convention and failed on the other.
 NO_RETURN_M = 3.0
-UNKNOWN_M = NO_RETURN_M
 
 
 @dataclass(frozen=True, eq=False)
