@@ -10,6 +10,8 @@ import argparse
 import logging
 import math
 import os
+import re
+import shlex
 import sys
 import time
 from pathlib import Path
@@ -30,30 +32,82 @@ class _Parser(argparse.ArgumentParser):
         raise _CliError(message)
 
 
-class _TqdmHandler(logging.Handler):
-    """Warnings on stderr, one line each, written around a live progress bar."""
+class _WarningHandler(logging.Handler):
+    """Warnings on stderr, one line each, written around a live progress bar.
+
+    Warnings alike but for their numbers (a recording with every other scan invalid) are
+    shown ``shown`` times; :meth:`summary` then says how many more there were, once a
+    kind. With ``every`` (``-v``) all are shown.
+    """
+
+    def __init__(self, shown: int = 3, every: bool = False) -> None:
+        super().__init__()
+        self.shown, self.every = shown, every
+        self.counts: dict[str, int] = {}
+        self.first: dict[str, str] = {}
 
     def emit(self, record: logging.LogRecord) -> None:
         try:
-            from tqdm import tqdm
-            tqdm.write(f"{PROG}: warning: {record.getMessage()}", file=sys.stderr)
+            text = record.getMessage()
+            kind = re.sub(r"-?\d+(\.\d+)?", "#", text)
+            self.counts[kind] = self.counts.get(kind, 0) + 1
+            self.first.setdefault(kind, text)
+            if self.every or self.counts[kind] <= self.shown:
+                self._write(f"{PROG}: warning: {text}")
         except Exception:  # pragma: no cover - logging must never raise
             self.handleError(record)
 
+    @staticmethod
+    def _write(line: str) -> None:
+        from tqdm import tqdm
+        tqdm.write(line, file=sys.stderr)
 
-def _setup_logging(quiet: bool) -> None:
+    def summary(self) -> None:
+        """One line for each kind of warning shown only in part (once: the counts restart)."""
+        for kind, n in self.counts.items():
+            if not self.every and n > self.shown:
+                self._write(f"{PROG}: warning: ... and {n - self.shown} more like this: {self.first[kind]}")
+        self.counts.clear()
+
+
+def _setup_logging(quiet: bool, verbose: bool) -> _WarningHandler:
     root = logging.getLogger()
-    root.handlers[:] = [_TqdmHandler()]
+    handler = _WarningHandler(every=verbose)
+    root.handlers[:] = [handler]
     root.setLevel(logging.ERROR if quiet else logging.WARNING)
+    return handler
+
+
+def _volume(parser: argparse.ArgumentParser, default) -> None:
+    """-q and -v, before the subcommand (``default`` False) or after it (not set unless given)."""
+    parser.add_argument("-q", "--quiet", action="store_true", default=default, help="no warnings, no progress bar")
+    parser.add_argument("-v", "--verbose", action="store_true", default=default,
+                        help="every warning, none grouped")
+
+
+def _scenario_list() -> str:
+    """The shipped scenarios with their one-line descriptions (read without parsing YAML)."""
+    from people_tracker.configs import shipped_file, shipped_names
+
+    lines = ["shipped scenarios:"]
+    for name in shipped_names("scenarios"):
+        m = re.search(r"^description:\s*(.+)$", shipped_file(name, "scenarios").read_text(encoding="utf-8"), re.M)
+        lines.append(f"  {name:<16} {m.group(1).strip().strip(chr(34)) if m else ''}")
+    return "\n".join(lines)
 
 
 def _build_parser() -> argparse.ArgumentParser:
+    from people_tracker import __version__
+
     p = _Parser(prog=PROG, description="Find and follow walking people in 2D laser scans.")
-    p.add_argument("-q", "--quiet", action="store_true", help="no warnings, no progress bar")
+    p.add_argument("--version", action="version", version=f"{PROG} {__version__}")
+    _volume(p, False)
+    common = argparse.ArgumentParser(add_help=False)
+    _volume(common, argparse.SUPPRESS)
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
 
-    run = sub.add_parser("run", help="run on a recording (or the built-in simulated scene)")
+    run = sub.add_parser("run", help="run on a recording (or the built-in simulated scene)", parents=[common])
     run.add_argument("input", nargs="?", metavar="INPUT",
                      help="a ROS 1 .bag, a ROS 2 bag folder, or an .mcap file")
     run.add_argument("--topic", help="LaserScan topic (default: the only one)")
@@ -65,7 +119,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--rrd", metavar="FILE.rrd", help="save a rerun recording of every stage")
     run.add_argument("--spawn", action="store_true", help="open the rerun viewer and stream to it")
 
-    ev = sub.add_parser("evaluate", help="score a tracks CSV against ground truth (CLEAR MOT, IDF1, OSPA)")
+    ev = sub.add_parser("evaluate", help="score a tracks CSV against ground truth (CLEAR MOT, IDF1, OSPA)", parents=[common])
     ev.add_argument("tracks", metavar="TRACKS.csv", help="needs the columns scan_index,track_id,x,y")
     ev.add_argument("--ground-truth", required=True, metavar="BAG|GT.csv",
                     help="an annotated recording or a ground-truth CSV (scan_index,person_id,x,y)")
@@ -80,7 +134,8 @@ def _build_parser() -> argparse.ArgumentParser:
                          "(Leigh et al. used -80 12 on the moving-robot recordings)")
     ev.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
 
-    sim = sub.add_parser("simulate", help="render a simulated scenario to a ROS 2 bag (MCAP) with ground truth")
+    sim = sub.add_parser("simulate", help="render a simulated scenario to a ROS 2 bag (MCAP) with ground truth",
+                         parents=[common], epilog=_scenario_list(), formatter_class=argparse.RawDescriptionHelpFormatter)
     sim.add_argument("scenario", metavar="SCENARIO", help="a name from configs/scenarios or a YAML file")
     sim.add_argument("--output", required=True, metavar="OUT", help="bag folder to create; ground truth goes to OUT.gt.csv")
     sim.add_argument("--seed", type=int, help="override the scenario's seed")
@@ -88,7 +143,7 @@ def _build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--duration", type=float, metavar="S", help="override the scenario's duration, seconds")
     sim.add_argument("--format", choices=("mcap", "sqlite3", "ros1"), default="mcap",
                      help="ROS 2 bag storage (mcap, sqlite3) or a ROS 1 .bag (default: mcap)")
-    tl = sub.add_parser("train-legs", help="fit the leg model to your own laser's recordings ([train] extra)")
+    tl = sub.add_parser("train-legs", help="fit the leg model to your own laser's recordings ([train] extra)", parents=[common])
     tl.add_argument("--positive", nargs="+", required=True, metavar="BAG[:TOPIC]",
                     help="recordings with people's legs: labelled in --label-topic, or inside --box")
     tl.add_argument("--negative", nargs="+", required=True, metavar="BAG[:TOPIC]",
@@ -101,7 +156,7 @@ def _build_parser() -> argparse.ArgumentParser:
     tl.add_argument("--trees", type=int, default=200, help="boosting rounds (%(default)s)")
     tl.add_argument("--simulated", type=int, default=600, metavar="N",
                     help="also N scans of simulated rooms with people and furniture, every leg known (%(default)s; 0: none)")
-    bench = sub.add_parser("bench", help="accuracy and speed on every recording and simulated scene")
+    bench = sub.add_parser("bench", help="accuracy and speed on every recording and simulated scene", parents=[common])
     bench.add_argument("--data", metavar="DIR", help="folder of recordings (default: $PEOPLE_TRACKER_DATA, "
                        "else ../shared/data)")
     bench.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
@@ -128,6 +183,15 @@ def _run_outputs(args) -> list[str]:
     """Every file ``run`` writes: the CSVs, their resolved configurations and the rerun file."""
     csvs = [out for out in (args.detections, args.tracks, args.legs) if out]
     return csvs + [f"{out}.config.yaml" for out in csvs] + ([args.rrd] if args.rrd else [])
+
+
+def _run_header(args, rec) -> str:
+    """What made an output, as YAML comments (the file still loads as a --config)."""
+    from people_tracker import __version__
+
+    return (f"# written by {PROG} {__version__}\n"
+            f"# command: {shlex.join([PROG, *getattr(args, 'argv', [])])}\n"
+            f"# input: {rec.path}\n# topic: {rec.topic}\n")
 
 
 def _cmd_run(args) -> int:
@@ -283,7 +347,7 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
             events = tracker.selector.events
             print(f"following: {', '.join(events) if events else 'no target found'}")
         for fh in sidecars:
-            fh.write(dump_config(config))
+            fh.write(_run_header(args, rec) + dump_config(config))
         if args.rrd:
             print(f"rerun recording: {args.rrd} (open it with: rerun {args.rrd})")
 
@@ -409,15 +473,18 @@ def main(argv: list[str] | None = None) -> int:
     except _CliError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
-    _setup_logging(args.quiet)
+    handler = _setup_logging(args.quiet, args.verbose and not args.quiet)
+    args.argv = list(argv)
     commands = {"run": _cmd_run, "evaluate": _cmd_evaluate, "simulate": _cmd_simulate, "bench": _cmd_bench,
                 "train-legs": _cmd_train_legs}
     try:
         return commands[args.command](args)
     except InputError as exc:
+        handler.summary()
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
+        handler.summary()
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
@@ -425,9 +492,12 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # never a traceback for users; PEOPLE_TRACKER_DEBUG=1 shows it
         if os.environ.get("PEOPLE_TRACKER_DEBUG"):
             raise
+        handler.summary()
         print(f"{PROG}: internal error: {type(exc).__name__}: {' '.join(str(exc).split())[:300]} "
               f"(set PEOPLE_TRACKER_DEBUG=1 for the traceback)", file=sys.stderr)
         return 1
+    finally:
+        handler.summary()
 
 
 if __name__ == "__main__":

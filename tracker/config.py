@@ -268,6 +268,21 @@ def _check_value(name: str, value: Any, typ: type, spec: dict) -> Any:
     return value
 
 
+# pairs of keys of one section where the first must not exceed the second (besides every
+# min_X and max_X, found by name)
+_ORDERED = (("confirm_hits", "confirm_window"), ("confirm_scans", "confirm_window"))
+
+
+def _check_order(values: dict, where: str) -> None:
+    """Every ``min_X`` at most its ``max_X``, and the pairs of ``_ORDERED``, in one section."""
+    pairs = [(k, "max_" + k[4:]) for k in values if k.startswith("min_") and "max_" + k[4:] in values]
+    pairs += [(a, b) for a, b in _ORDERED if a in values and b in values]
+    for lo, hi in pairs:
+        if isinstance(values[lo], (int, float)) and isinstance(values[hi], (int, float)) and values[lo] > values[hi]:
+            raise InputError(f"configuration key '{where}{lo}' ({values[lo]:g}) must not exceed "
+                             f"'{where}{hi}' ({values[hi]:g})")
+
+
 def _build(cls: type, data: dict, where: str):
     hints = typing.get_type_hints(cls)
     kwargs = {}
@@ -282,6 +297,7 @@ def _build(cls: type, data: dict, where: str):
             kwargs[f.name] = _build(typ, data[f.name], f"{name}.")
         else:
             kwargs[f.name] = _check_value(name, data[f.name], typ, f.metadata)
+    _check_order(kwargs, where)
     return cls(**kwargs)
 
 

@@ -102,6 +102,28 @@ def test_bad_scans_inside_a_good_recording_warn_once_each_and_keep_their_index(t
     assert "12 read, 9 used, 3 skipped, 1 history restarts" in proc.stdout
 
 
+def test_repeated_warnings_are_grouped_and_v_shows_them_all(tmp_path):
+    import numpy as np
+    scans = [bagmaker.make_scan(i, ranges=np.full(360, np.nan) if i % 2 else None) for i in range(40)]
+    bagmaker.write_bag(tmp_path / "half", "mcap", scans=scans)
+    proc = run_cli("run", str(tmp_path / "half"))
+    warnings = proc.stderr.strip().splitlines()
+    assert proc.returncode == 0 and len(warnings) == 4, warnings  # three, then the count of the rest
+    assert warnings[-1].startswith("people-tracker: warning: ... and 17 more like this: scan 1 ")
+    every = run_cli("run", str(tmp_path / "half"), "-v").stderr.strip().splitlines()
+    assert len(every) == 20 and not any("more like this" in w for w in every)
+    assert run_cli("run", str(tmp_path / "half"), "-q").stderr == ""
+
+
+def test_version_and_options_after_the_subcommand():
+    from people_tracker import __version__
+    assert run_cli("--version").stdout.strip() == f"people-tracker {__version__}"
+    proc = run_cli("simulate", "--help")
+    for name in ("crossing", "crowd", "room_drive", "case5_lateral"):
+        assert f"  {name} " in proc.stdout
+    assert "Two people cross" in proc.stdout
+
+
 
 def test_console_script_is_installed_beside_the_interpreter():
     import sys

@@ -58,3 +58,16 @@ def test_bad_files(tmp_path, text, words):
 def test_missing_file():
     with pytest.raises(InputError, match="does not exist"):
         load_config("/no/such/config.yaml")
+
+
+@pytest.mark.parametrize("override, words", [
+    ({"pairing": {"min_leg_size_m": 0.5}}, "'pairing.min_leg_size_m' (0.5) must not exceed 'pairing.max_leg_size_m'"),
+    ({"standing": {"min_leg_separation_m": 0.9}}, "'standing.min_leg_separation_m'"),
+    ({"alignment": {"min_correspondence_m": 0.9}}, "'alignment.min_correspondence_m'"),
+    ({"tracks": {"confirm_hits": 6}}, "'tracks.confirm_hits' (6) must not exceed 'tracks.confirm_window' (5)"),
+])
+def test_every_minimum_is_at_most_its_maximum(override, words):
+    from people_tracker.tracker.config import config_from_dict
+    from people_tracker.tracker.errors import InputError
+    with pytest.raises(InputError, match=re.escape(words)):
+        config_from_dict(override)
