@@ -1,0 +1,65 @@
+"""What the README shows exists: every people-tracker command and option it quotes is in that
+command's --help, and every script it names is in the repository."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from tests_helpers import run_cli
+
+REPO = Path(__file__).resolve().parents[1]
+DOCS = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+
+
+def _commands() -> list[tuple[str, str, str]]:
+    """(file, subcommand, options) of every people-tracker call in a code block or inline code."""
+    out = []
+    for doc in DOCS:
+        text = doc.read_text(encoding="utf-8")
+        for block in re.findall(r"```[a-z]*\n(.*?)```", text, re.S) + re.findall(r"`([^`\n]+)`", text):
+            for line in block.splitlines():
+                for call in re.findall(r"people-tracker((?:\s+[^\s&|;`]+)*)", line):
+                    words = call.split()
+                    if words and not words[0].startswith("-") and re.fullmatch(r"[a-z][a-z-]*", words[0]):
+                        out.append((doc.name, words[0], " ".join(w for w in words[1:] if w.startswith("--"))))
+    return out
+
+
+COMMANDS = _commands()
+
+
+def test_the_readme_shows_the_commands():
+    assert {c for _, c, _ in COMMANDS} >= {"run", "evaluate", "simulate", "bench", "train-legs"}
+
+
+@pytest.fixture(scope="module")
+def helps():
+    return {c: run_cli(c, "--help").stdout for c in {c for _, c, _ in COMMANDS}}
+
+
+@pytest.mark.parametrize("doc, command, options", COMMANDS)
+def test_every_command_and_option_exists(doc, command, options, helps):
+    assert helps[command], f"{doc}: 'people-tracker {command}' is not a command"
+    for option in options.split():
+        name = option.split("=")[0]
+        assert re.search(rf"(^|[\s,\[]){re.escape(name)}\b", helps[command]), f"{doc}: {command} has no {name}"
+
+
+def test_every_script_named_exists():
+    for doc in DOCS:
+        for script in re.findall(r"python (benchmarks/\w+\.py|demos/\w+\.py)", doc.read_text(encoding="utf-8")):
+            assert (REPO / script).is_file(), f"{doc.name} names {script}"
+
+
+def test_every_option_mentioned_exists_somewhere(helps):
+    known = " ".join(helps.values()) + run_cli("--help").stdout
+    for doc in DOCS:
+        text = doc.read_text(encoding="utf-8")
+        for code in re.findall(r"`([^`\n]+)`", text) + re.findall(r"```[a-z]*\n(.*?)```", text, re.S):
+            for option in re.findall(r"(?<![\w-])(--[a-z][a-z-]+)", code):
+                if option == "--help" or any(w in code for w in ("pip ", "pytest", "python ")):
+                    continue
+                assert re.search(rf"(^|[\s,\[]){re.escape(option)}\b", known), f"{doc.name}: no command has {option}"
