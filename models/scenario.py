@@ -166,7 +166,14 @@ def _walker(i: int, p: dict, rng: np.random.Generator) -> Walker:
                   None if radius is None else _num(p, "round_radius", 0.15, where, 0.01, 5.0))
 
 
-def _crowd(spec: dict, first_id: int, rng: np.random.Generator, count: int | None) -> list[Walker]:
+def _crowd(spec: dict, first_id: int, rng: np.random.Generator, count: int | None, duration_s: float = 0.0,
+           seed: int = 0) -> list[Walker]:
+    """Crowd walkers wandering between random waypoints in ``area``, pausing now and then.
+
+    Each walker gets ``waypoints`` points, and more until their walk lasts the whole
+    ``duration_s`` (drawn from a generator of their own, so a short scene is unchanged):
+    nobody stops for good at a last waypoint while the scene goes on.
+    """
     w = "crowd."
     n = int(_num(spec, "count", 30, w, 0, 10000) if count is None else count)
     x0, y0, x1, y1 = (float(a) for a in spec.get("area", [0, -5, 10, 5]))
@@ -179,7 +186,17 @@ def _crowd(spec: dict, first_id: int, rng: np.random.Generator, count: int | Non
         path = np.column_stack([rng.uniform(x0, x1, n_wp), rng.uniform(y0, y1, n_wp)])
         speed = float(rng.uniform(lo, hi))
         pauses = {i: float(rng.uniform(p_lo, p_hi)) for i in range(1, n_wp - 1) if rng.random() < p_pause}
-        out.append(Walker(first_id + k, path, speed, pauses, 0.0, False, PersonModel.sample(rng, speed)))
+        more = np.random.default_rng((seed, k))
+        points = list(path)
+        walk_s = float(np.hypot(*np.diff(path, axis=0).T).sum()) / speed + sum(pauses.values())
+        while walk_s < duration_s:
+            nxt = np.array([more.uniform(x0, x1), more.uniform(y0, y1)])
+            if more.random() < p_pause:  # a pause at the point reached before this one
+                pauses[len(points) - 1] = float(more.uniform(p_lo, p_hi))
+                walk_s += pauses[len(points) - 1]
+            walk_s += float(np.hypot(*(nxt - points[-1]))) / speed
+            points.append(nxt)
+        out.append(Walker(first_id + k, np.array(points), speed, pauses, 0.0, False, PersonModel.sample(rng, speed)))
     return out
 
 
@@ -211,7 +228,8 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
     noise = robot.get("odometry_noise", {}) or {}
     walkers = [_walker(i, p, rng) for i, p in enumerate(spec.get("people", []) or [])]
     if "crowd" in spec or crowd_count is not None:
-        walkers += _crowd(spec.get("crowd", {}) or {}, 1 + max([w.person_id for w in walkers], default=0), rng, crowd_count)
+        walkers += _crowd(spec.get("crowd", {}) or {}, 1 + max([w.person_id for w in walkers], default=0), rng,
+                          crowd_count, _num(spec, "duration_s", 20.0, "", 0.0, 86400.0, lo_open=True), seed)
     if "follow" in robot:
         f = robot["follow"]
         target = next((w for w in walkers if w.person_id == f.get("person")), None)
