@@ -35,7 +35,6 @@ import numpy as np
 
 from people_tracker.models.laser import LaserModel
 from people_tracker.models.leg_model import load_leg_model
-from people_tracker.models.pose import Pose2D
 from people_tracker.models.world import build_world
 from people_tracker.tracker import train_legs as T
 
@@ -76,33 +75,8 @@ def simulated_frames(resolution_deg: float, frames: int, seed: int = 1):
     furniture = np.array(furniture)
     laser = LaserModel(fov=math.radians(270), resolution=math.radians(resolution_deg), rate_hz=10.0,
                        range_max=20.0, noise_std=0.01)
-    out = []
-    for _ in range(frames):
-        people = []
-        for _ in range(rng.integers(3, 8)):
-            for _ in range(50):  # a place away from the furniture
-                r, a = rng.uniform(1.0, 5.0), rng.uniform(-2.0, 2.0)
-                c = np.array([r * math.cos(a), r * math.sin(a)])
-                if np.hypot(*(furniture[:, :2] - c).T).min() > 0.6 and all(np.hypot(*(c - p)) > 0.7 for p in people):
-                    people.append(c)
-                    break
-        legs = []
-        for c in people:
-            heading = rng.uniform(-math.pi, math.pi)
-            stride = rng.uniform(0.0, 0.35)  # 0: standing, feet side by side
-            spacing = rng.uniform(0.10, 0.30)
-            along = np.array([math.cos(heading), math.sin(heading)])
-            across = np.array([-along[1], along[0]])
-            radius = rng.uniform(0.05, 0.08)
-            for s in (-0.5, 0.5):
-                legs.append((*(c + s * stride * along + s * spacing * across), radius))
-        legs = np.array(legs)
-        circles = np.vstack([world.circles, furniture, legs])
-        scan, hit = laser.render(0.0, Pose2D(), world.segments, circles, rng)
-        first_leg = len(world.segments) + len(world.circles) + len(furniture)
-        counts = np.bincount(hit[scan.valid & (hit >= first_leg)] - first_leg, minlength=len(legs))
-        out.append((scan, legs[counts >= 2, :2]))
-    return out
+    return [T.people_among_furniture(laser, world, furniture, rng, int(rng.integers(3, 8)), (1.0, 5.0), 2.0,
+                                     (0.6, 0.7), 0.35, (0.05, 0.08)) for _ in range(frames)]
 
 
 def main(argv=None) -> int:

@@ -433,16 +433,15 @@ def _cmd_train_legs(args) -> int:
         raise InputError("--trees must be between 10 and 5000")
     if not 0 <= args.simulated <= 100000:
         raise InputError("--simulated must be between 0 and 100000")
-    inputs = [_bag_and_topic(a) for a in args.positive + args.negative]
-    check_outputs([b for b, _ in inputs], [args.output])
+    positive_args = [_bag_and_topic(a) for a in args.positive]
+    negative_args = [_bag_and_topic(a) for a in args.negative]
+    check_outputs([b for b, _ in positive_args + negative_args], [args.output])
     t0 = time.perf_counter()
     positives, negatives, names = [], [], []
-    for arg in args.positive:
-        bag, topic = _bag_and_topic(arg)
+    for bag, topic in positive_args:
         positives.append(T.read_labelled(bag, topic, args.label_topic, tuple(args.box) if args.box else None))
         names.append(f"{bag}{':' + topic if topic else ''}")
-    for arg in args.negative:
-        bag, topic = _bag_and_topic(arg)
+    for bag, topic in negative_args:
         for t in ([topic] if topic else T.laser_topics(bag)):
             negatives.append([s for _, s in T.read_scans(bag, t)])
             names.append(f"{bag}:{t}")

@@ -193,6 +193,43 @@ def transplanted(labelled: list[list[LabelledScan]], rooms: list[list[Scan]], pe
     return out
 
 
+def people_among_furniture(laser, world, furniture: np.ndarray, rng: np.random.Generator, count: int,
+                           range_m: tuple[float, float], bearing_rad: float, clearance_m: tuple[float, float],
+                           max_stride_m: float, leg_radius_m: tuple[float, float]) -> tuple[Scan, np.ndarray]:
+    """One scan of ``count`` people placed at random among ``furniture`` (rows x, y, radius)
+    in ``world``, seen by ``laser`` from the origin, and the centres of the legs it shows
+    two readings or more of (sensor frame, m).
+
+    Each person stands ``range_m`` away within ``bearing_rad`` of straight ahead, at least
+    ``clearance_m`` (from furniture, from other people) clear, standing or mid-stride (up
+    to ``max_stride_m``), legs 10-30 cm apart of a radius in ``leg_radius_m``."""
+    import math
+
+    from people_tracker.models.pose import Pose2D
+
+    people: list[np.ndarray] = []
+    for _ in range(count):
+        for _ in range(50):  # a free place
+            r, a = rng.uniform(*range_m), rng.uniform(-bearing_rad, bearing_rad)
+            c = np.array([r * math.cos(a), r * math.sin(a)])
+            if (np.hypot(*(furniture[:, :2] - c).T).min() > clearance_m[0]
+                    and all(np.hypot(*(c - q)) > clearance_m[1] for q in people)):
+                people.append(c)
+                break
+    legs = []
+    for c in people:
+        heading, stride, spacing = rng.uniform(-math.pi, math.pi), rng.uniform(0, max_stride_m), rng.uniform(0.1, 0.3)
+        radius = rng.uniform(*leg_radius_m)
+        along = np.array([math.cos(heading), math.sin(heading)])
+        across = np.array([-along[1], along[0]])
+        legs += [(*(c + s * stride * along + s * spacing * across), radius) for s in (-0.5, 0.5)]
+    legs = np.array(legs).reshape(-1, 3)
+    scan, hit = laser.render(0.0, Pose2D(), world.segments, np.vstack([world.circles, furniture, legs]), rng)
+    first = len(world.segments) + len(world.circles) + len(furniture)
+    seen = np.bincount(hit[scan.valid & (hit >= first)] - first, minlength=len(legs))
+    return scan, legs[seen >= 2, :2]
+
+
 def simulated_rooms(n_scans: int, seed: int = 100, resolutions_deg=(0.25, 0.35, 0.5, 0.75)) -> list[LabelledScan]:
     """Scans of randomised furnished rooms with people, every leg labelled.
 
@@ -205,7 +242,6 @@ def simulated_rooms(n_scans: int, seed: int = 100, resolutions_deg=(0.25, 0.35, 
     import math
 
     from people_tracker.models.laser import LaserModel
-    from people_tracker.models.pose import Pose2D
     from people_tracker.models.world import build_world
 
     rng = np.random.default_rng(seed)
@@ -224,27 +260,9 @@ def simulated_rooms(n_scans: int, seed: int = 100, resolutions_deg=(0.25, 0.35, 
             furniture = np.array(legs_)
             laser = LaserModel(fov=math.radians(270), resolution=math.radians(float(rng.choice(resolutions_deg))),
                                range_max=20.0, noise_std=rng.uniform(0.005, 0.02))
-        people: list[np.ndarray] = []
-        for _ in range(rng.integers(1, 7)):
-            for _ in range(50):  # a free place
-                r, a = rng.uniform(0.7, 6.0), rng.uniform(-2.2, 2.2)
-                c = np.array([r * math.cos(a), r * math.sin(a)])
-                if (np.hypot(*(furniture[:, :2] - c).T).min() > 0.5
-                        and all(np.hypot(*(c - q)) > 0.6 for q in people)):
-                    people.append(c)
-                    break
-        legs = []
-        for c in people:
-            heading, stride, spacing = rng.uniform(-math.pi, math.pi), rng.uniform(0, 0.4), rng.uniform(0.1, 0.3)
-            radius = rng.uniform(0.045, 0.085)
-            along = np.array([math.cos(heading), math.sin(heading)])
-            across = np.array([-along[1], along[0]])
-            legs += [(*(c + s * stride * along + s * spacing * across), radius) for s in (-0.5, 0.5)]
-        legs = np.array(legs).reshape(-1, 3)
-        scan, hit = laser.render(0.0, Pose2D(), world.segments, np.vstack([world.circles, furniture, legs]), rng)
-        first = len(world.segments) + len(world.circles) + len(furniture)
-        seen = np.bincount(hit[scan.valid & (hit >= first)] - first, minlength=len(legs))
-        out.append(LabelledScan(scan, legs[seen >= 2, :2], complete=True))
+        scan, legs = people_among_furniture(laser, world, furniture, rng, int(rng.integers(1, 7)), (0.7, 6.0), 2.2,
+                                            (0.5, 0.6), 0.4, (0.045, 0.085))
+        out.append(LabelledScan(scan, legs, complete=True))
     return out
 
 

@@ -36,7 +36,7 @@ import rerun.blueprint as rrb
 import shapely
 
 from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
-from people_tracker.tracker.io.atomic import OutputError, publish
+from people_tracker.tracker.io.atomic import OutputError, publish, temp_beside
 from people_tracker.tracker.sinks import Sink
 
 VIEWER_PORT = 9876  # rerun's default
@@ -126,11 +126,7 @@ class RerunSink(Sink):
         self._target = Path(rrd) if rrd else None
         self._tmp = None
         if self._target is not None:
-            try:
-                fd, tmp = tempfile.mkstemp(prefix=f".{self._target.name}.", suffix=".part",
-                                           dir=self._target.parent if str(self._target.parent) else ".")
-            except OSError as exc:
-                raise OutputError(f"cannot write output '{self._target}': {exc.strerror or exc}") from None
+            fd, tmp = temp_beside(self._target)
             os.close(fd)
             self._tmp = Path(tmp)
             self.rec.save(str(self._tmp))

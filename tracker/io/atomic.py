@@ -89,6 +89,15 @@ class _CheckedFile:
         return getattr(self._fh, name)
 
 
+def temp_beside(path: Path) -> tuple[int, str]:
+    """A new hidden ``.part`` file in ``path``'s folder (descriptor and name), where it will be
+    moved into place with :func:`publish`; :class:`OutputError` when none can be made."""
+    try:
+        return tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent if str(path.parent) else ".")
+    except OSError as exc:
+        raise OutputError(f"cannot write output '{path}': {_why(exc)}") from None
+
+
 @contextlib.contextmanager
 def atomic_output(path: str | Path, mode: str = "w", newline: str | None = "") -> Iterator[IO]:
     """Open a temporary file beside ``path``; on success it replaces ``path``, on error it vanishes.
@@ -97,10 +106,7 @@ def atomic_output(path: str | Path, mode: str = "w", newline: str | None = "") -
     :class:`OutputError`; anything else raised in the block passes through unchanged.
     """
     p = check_writable(path)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".part", dir=p.parent if str(p.parent) else ".")
-    except OSError as exc:
-        raise OutputError(f"cannot write output '{p}': {_why(exc)}") from None
+    fd, tmp = temp_beside(p)
     kwargs = {} if "b" in mode else {"newline": newline, "encoding": "utf-8"}
     fh = os.fdopen(fd, mode, **kwargs)
     try:
