@@ -13,8 +13,10 @@ person's legs stand still and a walking person's stance leg does too:
   the legs' midpoint;
 * the cadence (steps per second) is ``speed / step_length``, so it follows the speed.
 
-Pauses start at the middle of a step, where the swinging leg passes the standing one, so a
-standing person has both feet side by side.
+Pauses start at the middle of a step, where the swinging leg passes the standing one, and a
+standing person has both feet side by side, across the direction they were walking (also where
+the path turns back there). ``step_phase_m`` shifts the footprints along the path, so a walker
+can be made to take a mid-step, and stop, exactly on a chosen waypoint.
 """
 
 from __future__ import annotations
@@ -79,6 +81,7 @@ class Walker:
     exit_at_end: bool = False
     body: PersonModel = field(default_factory=PersonModel)
     round_radius: float | None = None  # set: a round object of this radius (m) instead of two legs
+    step_phase_m: float = 0.0  # m: footprints lie at (k + ½)·step_length + this along the path
 
     def __post_init__(self) -> None:
         wp = np.asarray(self.waypoints, dtype=float).reshape(-1, 2)
@@ -95,15 +98,17 @@ class Walker:
         speeds = np.broadcast_to(np.asarray(self.speed, dtype=float), (len(seg),)).astype(float)
         if (speeds <= 0).any():
             raise ValueError("walking speed must be positive")
-        L = self.body.step_length
+        L, phi = self.body.step_length, self.step_phase_m
 
         def mid_step_at_or_after(s: float) -> float:  # feet side by side there
-            return (math.ceil(s / L - 0.5) + 0.5) * L
+            return (math.ceil((s - phi) / L - 0.5 - 1e-9) + 0.5) * L + phi
 
         total = float(self._cum[-1])
         # the walk ends at the last mid-step of the path, so a person standing there has
         # both feet side by side
-        s_end = (math.floor(total / L - 0.5) + 0.5) * L if total >= 0.5 * L and self.round_radius is None else total
+        s_end = (math.floor((total - phi) / L - 0.5 + 1e-9) + 0.5) * L + phi
+        if not 0.0 <= s_end <= total or self.round_radius is not None:
+            s_end = total
         # timeline of pieces (t_start, s_start, speed); speed 0 for a pause
         t, s = self.start_time, 0.0
         pieces = []
@@ -134,13 +139,17 @@ class Walker:
 
     def arc_length(self, t: float) -> float:
         """Distance walked along the path by time ``t``, metres."""
+        return self._walk(t)[0]
+
+    def _walk(self, t: float) -> tuple[float, bool]:
+        """Arc length walked by time ``t`` (m) and whether the person is standing then."""
         if t <= self.start_time:
-            return 0.0
+            return 0.0, len(self._pieces) > 0 and self._pieces[0, 2] == 0.0
         if t >= self.end_time:
-            return self._s_end
+            return self._s_end, True
         i = int(np.searchsorted(self._pieces[:, 0], t, side="right")) - 1
         t0, s0, v = self._pieces[i]
-        return float(min(s0 + v * (t - t0), self._s_end))
+        return float(min(s0 + v * (t - t0), self._s_end)), bool(v == 0.0)
 
     def _at(self, s: float) -> tuple[np.ndarray, np.ndarray]:
         """Point and unit direction of the path at arc length ``s``."""
@@ -158,7 +167,7 @@ class Walker:
         return self._at(self.arc_length(t))[0]
 
     def _footprint(self, k: int) -> np.ndarray:
-        p, u = self._at((k + 0.5) * self.body.step_length)
+        p, u = self._at((k + 0.5) * self.body.step_length + self.step_phase_m)
         side = 1.0 if k % 2 == 0 else -1.0  # even footprints left of the path, odd right
         normal = np.array([-u[1], u[0]])
         return p + side * 0.5 * self.body.leg_spacing * normal
@@ -172,10 +181,14 @@ class Walker:
     def legs(self, t: float) -> np.ndarray:
         """Centres of the two legs at time ``t``, shape (2, 2): row 0 the stance leg."""
         L = self.body.step_length
-        s = self.arc_length(t)
-        k = int(math.floor(s / L + 1e-9))
-        phase = s / L - k  # 0 … 1 through the step
+        s, standing = self._walk(t)
+        k = int(math.floor((s - self.step_phase_m) / L + 1e-9))
+        phase = (s - self.step_phase_m) / L - k  # 0 … 1 through the step
         stance = self._footprint(k)
+        if standing and abs(phase - 0.5) < 1e-6:
+            # feet side by side across the path, also where it turns back (the footprints
+            # either side of a turn do not straddle the torso)
+            return np.vstack([stance, 2.0 * self._at(s)[0] - stance])
         a, b = self._footprint(k - 1), self._footprint(k + 1)
         # footprints k-1 and k+1 lie on the same side, so the swinging leg passes beside
         # the standing one

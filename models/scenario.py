@@ -15,6 +15,15 @@ file, radians inside)::
     people: [{id, path: [[x, y], ...], speed: m/s or list, start_s, pauses: {waypoint: s},
               exit: bool, round_radius: m (a round object instead of legs)}]
     crowd: {count, area: [x0, y0, x1, y1], speed: [lo, hi], waypoints: n, pause_s: [lo, hi]}
+    visitors: {count, door: [x, y], area: [x0, y0, x1, y1], range_m: [lo, hi], stand_s: [lo, hi],
+               arrive_every_s: [lo, hi], speed: [lo, hi], face_to_face: pairs, distance_m: [lo, hi]}
+    furniture: {count, area: [x0, y0, x1, y1], range_m: [lo, hi], radius_m: [lo, hi], spacing_m: [lo, hi]}
+
+``visitors`` walk in from the door one after another, stand at a spot of their own in ``area``
+(``range_m`` from the sensor) for ``stand_s`` and walk out; ``face_to_face`` pairs of them
+stand ``distance_m`` apart facing each other. ``furniture`` is ``count`` pairs of round legs
+(tables, chairs) in the same kind of place, there from the first scan. Both are drawn from
+the seed.
 
 Every key is checked: an unknown one is an error that names it.
 """
@@ -34,7 +43,7 @@ from people_tracker.models.person import PersonModel, Walker
 from people_tracker.models.pose import Pose2D
 from people_tracker.models.robot import FollowDriver, ScriptedDriver, WaypointDriver
 from people_tracker.models.simulator import Simulation
-from people_tracker.models.world import build_world
+from people_tracker.models.world import World, build_world
 
 
 class ScenarioError(ValueError):
@@ -42,7 +51,8 @@ class ScenarioError(ValueError):
 
 
 _KEYS = {
-    "": {"description", "duration_s", "seed", "laser", "world", "robot", "people", "crowd"},
+    "": {"description", "duration_s", "seed", "laser", "world", "robot", "people", "crowd", "visitors",
+         "furniture"},
     "laser": {"fov_deg", "resolution_deg", "rate_hz", "range_min", "range_max", "noise_std", "dropout",
               "dropout_value", "clockwise", "frame_id", "sweep_fraction"},
     "world": {"room", "walls", "boxes", "pillars"},
@@ -51,6 +61,9 @@ _KEYS = {
     "robot.odometry_noise": {"trans", "rot"},
     "people[]": {"id", "path", "speed", "start_s", "pauses", "exit", "round_radius"},
     "crowd": {"count", "area", "speed", "waypoints", "pause_s", "pause_probability"},
+    "visitors": {"count", "door", "area", "range_m", "stand_s", "arrive_every_s", "speed", "face_to_face",
+                 "distance_m"},
+    "furniture": {"count", "area", "range_m", "radius_m", "spacing_m"},
 }
 
 
@@ -96,7 +109,7 @@ def _check_keys(spec: dict) -> None:
                 name = f"{where}.{k}" if where else k
                 raise ScenarioError(f"unknown scenario key '{name}'")
     check(spec, "")
-    for sec in ("laser", "world", "robot", "crowd"):
+    for sec in ("laser", "world", "robot", "crowd", "visitors", "furniture"):
         if sec in spec:
             check(spec[sec], sec)
     for sub in ("odometry_noise", "follow"):
@@ -200,6 +213,112 @@ def _crowd(spec: dict, first_id: int, rng: np.random.Generator, count: int | Non
     return out
 
 
+def _interval(d: dict, key: str, default: list[float], where: str, lo: float = 0.0) -> tuple[float, float]:
+    v = d.get(key, default)
+    try:
+        a, b = (float(x) for x in v)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"scenario key '{where}{key}' must be [lo, hi]") from None
+    if not (math.isfinite(a) and math.isfinite(b) and lo <= a <= b):
+        raise ScenarioError(f"scenario key '{where}{key}' must be [lo, hi] with {lo} <= lo <= hi, got {v!r}")
+    return a, b
+
+
+def _place(rng: np.random.Generator, area, range_m, sensor: np.ndarray, clear_of: list[tuple[np.ndarray, float]],
+           tries: int = 500) -> np.ndarray | None:
+    """A random point in ``area`` at ``range_m`` from ``sensor``, farther than r from each (p, r)."""
+    x0, y0, x1, y1 = area
+    for _ in range(tries):
+        p = np.array([rng.uniform(x0, x1), rng.uniform(y0, y1)])
+        if not range_m[0] <= np.hypot(*(p - sensor)) <= range_m[1]:
+            continue
+        if all(np.hypot(*(p - q)) > r for q, r in clear_of):
+            return p
+    return None
+
+
+def _area(d: dict, where: str) -> tuple[float, float, float, float]:
+    try:
+        x0, y0, x1, y1 = (float(a) for a in d.get("area", [0, -5, 10, 5]))
+    except (TypeError, ValueError):
+        raise ScenarioError(f"scenario key '{where}area' must be [x0, y0, x1, y1]") from None
+    if not (x0 < x1 and y0 < y1):
+        raise ScenarioError(f"scenario key '{where}area' must have x0 < x1 and y0 < y1")
+    return x0, y0, x1, y1
+
+
+def _furniture(spec: dict, rng: np.random.Generator, sensor: np.ndarray) -> np.ndarray:
+    """Pairs of round legs (x, y, r), shape (2·count, 3), metres."""
+    w = "furniture."
+    n = int(_num(spec, "count", 6, w, 0, 1000))
+    area, range_m = _area(spec, w), _interval(spec, "range_m", [2.0, 6.0], w)
+    r_lo, r_hi = _interval(spec, "radius_m", [0.02, 0.06], w)
+    s_lo, s_hi = _interval(spec, "spacing_m", [0.2, 0.5], w)
+    legs: list[tuple[float, float, float]] = []
+    for _ in range(n):
+        c = _place(rng, area, range_m, sensor, [(np.array(q[:2]), 0.8) for q in legs])
+        if c is None:
+            break
+        a, spacing, r = rng.uniform(0, math.pi), rng.uniform(s_lo, s_hi), rng.uniform(r_lo, r_hi)
+        half = 0.5 * spacing * np.array([math.cos(a), math.sin(a)])
+        legs += [(*(c + half), r), (*(c - half), r)]
+    return np.array(legs, dtype=float).reshape(-1, 3)
+
+
+def _visitors(spec: dict, first_id: int, rng: np.random.Generator, sensor: np.ndarray,
+              furniture: np.ndarray) -> list[Walker]:
+    """People who walk in from the door one after another, stand a while at a spot and leave."""
+    w = "visitors."
+    n = int(_num(spec, "count", 10, w, 0, 1000))
+    try:
+        door = np.array([float(a) for a in spec.get("door", [0.0, 4.0])]).reshape(2)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"scenario key '{w}door' must be [x, y]") from None
+    area, range_m = _area(spec, w), _interval(spec, "range_m", [2.0, 6.0], w)
+    stand, every = _interval(spec, "stand_s", [120.0, 240.0], w), _interval(spec, "arrive_every_s", [10.0, 40.0], w)
+    v_lo, v_hi = _interval(spec, "speed", [0.6, 1.2], w, lo=0.1)
+    d_lo, d_hi = _interval(spec, "distance_m", [0.6, 0.9], w)
+    pairs = int(_num(spec, "face_to_face", 1, w, 0, n // 2))
+    # the second and third arrival, the fifth and sixth, … stand face to face
+    partner_of = {3 * k + 2: 3 * k + 1 for k in range(pairs)}
+    furniture_clear = [(np.array(f[:2]), 0.6) for f in furniture]
+    spots: list[tuple[np.ndarray, float, float]] = []  # where, from, until (s)
+    out, t = [], float(rng.uniform(*every)) * 0.25
+    for i in range(n):
+        speed = float(rng.uniform(v_lo, v_hi))
+        body = PersonModel.sample(rng, speed)
+        stand_s = float(rng.uniform(*stand))
+        spot = None
+        if i in partner_of and partner_of[i] < len(out):
+            a = out[partner_of[i]]
+            u = a.waypoints[2] - a.waypoints[1]
+            u /= np.hypot(*u)
+            spot = a.waypoints[2] + u * rng.uniform(d_lo, d_hi)  # ahead of the partner, facing back
+            if (not range_m[0] <= np.hypot(*(spot - sensor)) <= range_m[1]
+                    or any(np.hypot(*(spot - q)) <= r for q, r in furniture_clear)):
+                spot = None
+            else:
+                pre, t = spot + 1.0 * u, t + float(rng.uniform(2.0, 6.0))
+        if spot is None:
+            if i > 0:
+                t += float(rng.uniform(*every))
+            busy = [(p, 1.2) for p, t0, t1 in spots if t0 < t + stand_s + 60.0 and t1 > t - 60.0]
+            spot = _place(rng, area, range_m, sensor, furniture_clear + busy)
+            if spot is None:
+                continue
+            # they come in from the door's side, not straight at the spot
+            a = math.atan2(*(spot - door)[::-1]) + rng.uniform(-1.0, 1.0)
+            pre = spot - np.array([math.cos(a), math.sin(a)])
+        path = np.array([door, pre, spot, door])
+        arrive = float(np.hypot(*(pre - door)) + 1.0)
+        L = body.step_length
+        walker = Walker(first_id + len(out), path, speed, {2: stand_s}, t, True, body,
+                        step_phase_m=(arrive - 0.5 * L) % L)
+        spots.append((spot, t, t + arrive / speed + stand_s))
+        out.append(walker)
+    return out
+
+
 def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | None = None) -> tuple[Simulation, int]:
     """The simulation of a scenario and its number of scans.
 
@@ -230,6 +349,14 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
     if "crowd" in spec or crowd_count is not None:
         walkers += _crowd(spec.get("crowd", {}) or {}, 1 + max([w.person_id for w in walkers], default=0), rng,
                           crowd_count, _num(spec, "duration_s", 20.0, "", 0.0, 86400.0, lo_open=True), seed)
+    sensor = start.compose(mount)
+    sensor_xy = np.array([sensor.x, sensor.y])
+    furniture = _furniture(spec["furniture"] or {}, rng, sensor_xy) if "furniture" in spec else np.zeros((0, 3))
+    if len(furniture):
+        world = World(world.segments, np.vstack([world.circles, furniture]))
+    if "visitors" in spec:
+        walkers += _visitors(spec["visitors"] or {}, 1 + max([w.person_id for w in walkers], default=0), rng,
+                             sensor_xy, furniture)
     if "follow" in robot:
         f = robot["follow"]
         target = next((w for w in walkers if w.person_id == f.get("person")), None)

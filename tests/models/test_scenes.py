@@ -4,6 +4,7 @@ without rendering)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from people_tracker.models.scenario import build_simulation, load_scenario
 
@@ -15,3 +16,49 @@ def test_a_long_crowd_keeps_wandering_to_the_end():
     assert np.mean(moved) > 0.8  # in the last minute of 20, nearly everyone is on the move
     short, _ = build_simulation(load_scenario("crowd"))  # a 30 s crowd is the same as it always was
     assert [len(w.waypoints) for w in short.walkers] == [8] * 30
+
+
+@pytest.mark.parametrize("seed", [21, 22, 23])
+def test_the_waiting_room_keeps_its_promises(seed):
+    sim, n_scans = build_simulation(load_scenario("waiting_room"), seed=seed)
+    sensor = np.zeros(2)  # the laser stands at the origin, still
+    assert sim.driver is None and n_scans == round(600 * sim.laser.rate_hz)
+    assert np.degrees(sim.laser.fov) == pytest.approx(270)
+    walkers = sim.walkers
+    assert len(walkers) >= 10
+    starts = [w.start_time for w in walkers]
+    assert starts == sorted(starts) and len(set(starts)) == len(starts)  # one after another
+    spots = []
+    for w in walkers:
+        stand = w.pauses[2]
+        assert 120 <= stand <= 240
+        # standing: the torso stays on the spot for the whole pause, feet side by side
+        t0 = w.start_time + np.hypot(*np.diff(w.waypoints[:3], axis=0).T).sum() / float(np.asarray(w.speed).flat[0])
+        for t in np.linspace(t0 + 0.5, t0 + stand - 0.5, 7):
+            assert np.hypot(*(w.torso(t) - w.waypoints[2])) < 1e-6
+            legs = w.legs(t)
+            assert np.hypot(*(legs[0] - legs[1])) == pytest.approx(w.body.leg_spacing, abs=1e-6)
+            assert np.allclose(legs.mean(axis=0), w.waypoints[2])
+        assert 2.0 <= np.hypot(*(w.waypoints[2] - sensor)) <= 6.0
+        assert w.exit_at_end and not w.present(w.end_time + 0.1)  # they walk out
+        spots.append((w.waypoints[2], w.waypoints[1], t0, t0 + stand))
+    # two of them stand face to face, 0.6-0.9 m apart, at the same time
+    facing = 0
+    for i, (a, a_pre, a0, a1) in enumerate(spots):
+        for b, b_pre, b0, b1 in spots[i + 1:]:
+            d = np.hypot(*(a - b))
+            if 0.6 <= d <= 0.9 and max(a0, b0) + 60 < min(a1, b1):
+                ua, ub = (a - a_pre) / np.hypot(*(a - a_pre)), (b - b_pre) / np.hypot(*(b - b_pre))
+                facing += bool(np.dot(ua, b - a) > 0.99 * d and np.dot(ub, a - b) > 0.99 * d)
+    assert facing >= 1
+    # table and chair legs: pairs of human-leg-sized circles 0.2-0.5 m apart, 2-6 m out,
+    # there from the first scan, where people also stand
+    legs = sim.world.circles
+    assert len(legs) >= 12 and len(legs) % 2 == 0
+    assert ((legs[:, 2] >= 0.02) & (legs[:, 2] <= 0.06)).all()
+    spacing = np.hypot(*(legs[0::2, :2] - legs[1::2, :2]).T)
+    assert ((spacing >= 0.2) & (spacing <= 0.5)).all()
+    r = np.hypot(*legs[:, :2].T)
+    assert ((r >= 1.7) & (r <= 6.3)).all()
+    standing_at = np.array([s[0] for s in spots])
+    assert (np.hypot(*(legs[:, None, :2] - standing_at[None]).T).min(axis=0) < 3.0).mean() > 0.5

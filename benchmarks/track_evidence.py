@@ -1,0 +1,187 @@
+"""Tracks that live on evidence: the figures of the track-existence work, on simulated scenes.
+
+For each scene and seed the default tracker runs over the simulated scans (in-process, as
+``people-tracker bench`` does) and the script prints:
+
+* CLEAR MOT (0.75 m) and IDF1 against the visible people, through ``evaluate``;
+* per minute: the mean number of visible people and of reported people (``count`` column:
+  reported / visible, the target is within 10 %);
+* ``ids/person``: the most distinct track ids any one person was given while they were in
+  the scene (matched within 0.5 m), the target is 1;
+* ``false>=2s``: reported tracks that spent 2 s or more in a row farther than 0.75 m from
+  every person in the scene (furniture, ghosts);
+
+and, pooled over every scene run, the calibration table of ``confidence``: of the reported
+track-scans whose confidence falls in a 0.1-wide bin, the share within 0.5 m of a person.
+
+Usage::
+
+    python benchmarks/track_evidence.py                          # every figure (about 10 min)
+    python benchmarks/track_evidence.py --scenes waiting_room --seeds 21
+    python benchmarks/track_evidence.py --scenes crowd --duration 1200
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+from people_tracker.models.pose import pairwise_distances
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.evaluation import TrackRows, evaluate
+from people_tracker.tracker.io.ground_truth import GroundTruth
+from people_tracker.tracker.io.simulated import SimulatedSource
+from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+
+NEAR_M = 0.5  # a reported track this close to a person is that person (calibration, ids)
+FALSE_M = 0.75  # farther than this from everyone is a false person (the evaluation's threshold)
+LASTING_S = 2.0
+
+
+@dataclass
+class SceneRun:
+    name: str
+    seed: int | None
+    stamps: np.ndarray  # (n,) s
+    rows: np.ndarray  # (m, 5): scan index, track id, x, y (sensor frame, m), confidence
+    world_rows: np.ndarray  # (m, 2): x, y in the world frame, m
+    truths: list  # the simulator's Truth per scan
+
+
+def run_scene(name: str, seed: int | None, duration: float | None, people: int | None = None) -> SceneRun:
+    source = SimulatedSource(name, seed=seed, duration=duration, people=people)
+    tracker = PeopleTracker.from_config(load_config())
+    rows, world, stamps = [], [], []
+    for record in source.scans():
+        tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
+        stamps.append(record.scan.stamp)
+        for t, (x, y) in zip(tracks, tracks_in_sensor_frame(tracks, tracker.last.pose)):
+            rows.append((record.index, t.track_id, x, y, t.confidence))
+            world.append((t.x, t.y))
+    return SceneRun(name, seed, np.array(stamps), np.array(rows, dtype=float).reshape(-1, 5),
+                    np.array(world, dtype=float).reshape(-1, 2), source.truths)
+
+
+def ground_truth(run: SceneRun) -> GroundTruth:
+    g = np.array([(i, p, x, y) for i, tr in enumerate(run.truths)
+                  for p, (x, y) in zip(tr.person_id[tr.visible], tr.torso_sensor[tr.visible])],
+                 dtype=float).reshape(-1, 4)
+    return GroundTruth(len(run.truths), g[:, 0].astype(np.int64), g[:, 1].astype(np.int64), g[:, 2], g[:, 3])
+
+
+def nearest_person(run: SceneRun) -> tuple[np.ndarray, np.ndarray]:
+    """For each reported row: the distance to the nearest person in the scene (m) and their id."""
+    dist = np.full(len(run.rows), np.inf)
+    who = np.full(len(run.rows), -1, dtype=np.int64)
+    scan = run.rows[:, 0].astype(np.int64)
+    for k in np.unique(scan):
+        sel = np.flatnonzero(scan == k)
+        tr = run.truths[k]
+        if len(tr.person_id) == 0:
+            continue
+        d = pairwise_distances(run.world_rows[sel], tr.torso_world)
+        j = d.argmin(axis=1)
+        dist[sel] = d[np.arange(len(sel)), j]
+        who[sel] = tr.person_id[j]
+    return dist, who
+
+
+def scene_figures(run: SceneRun) -> dict:
+    r = run.rows
+    result = evaluate(ground_truth(run), TrackRows(r[:, 0].astype(np.int64), r[:, 1].astype(np.int64), r[:, 2], r[:, 3]))
+    dist, who = nearest_person(run)
+    # reported / visible people per minute
+    minute = ((run.stamps - run.stamps[0]) // 60.0).astype(int)
+    visible = np.array([int(tr.visible.sum()) for tr in run.truths])
+    reported = np.bincount(r[:, 0].astype(np.int64), minlength=len(run.truths))
+    ratios = []
+    for m in np.unique(minute):
+        v, p = visible[minute == m].mean(), reported[minute == m].mean()
+        ratios.append((v, p))
+    # distinct ids per person (matched within NEAR_M)
+    near = dist <= NEAR_M
+    ids = {}
+    for p, t in zip(who[near], r[near, 1].astype(np.int64)):
+        ids.setdefault(int(p), set()).add(int(t))
+    # false people reported for LASTING_S in a row
+    false_ids = 0
+    far = dist > FALSE_M
+    for t in np.unique(r[:, 1]):
+        sel = np.flatnonzero(r[:, 1] == t)
+        run_start, best = None, 0.0
+        for k, f in zip(r[sel, 0].astype(np.int64), far[sel]):
+            if f:
+                run_start = run.stamps[k] if run_start is None else run_start
+                best = max(best, run.stamps[k] - run_start)
+            else:
+                run_start = None
+        false_ids += best >= LASTING_S
+    return {"result": result, "minutes": ratios, "ids_per_person": max((len(s) for s in ids.values()), default=0),
+            "people_with_more_ids": sum(len(s) > 1 for s in ids.values()), "false_lasting": false_ids,
+            "confidence": r[:, 4], "near": near}
+
+
+def calibration_table(confidence: np.ndarray, near: np.ndarray, min_samples: int = 100) -> list[str]:
+    lines = [f"{'confidence':>12} {'track-scans':>11} {'mean conf':>9} {'near a person':>13} {'|diff|':>6}"]
+    edges = np.linspace(0.0, 1.0, 11)
+    worst = 0.0
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        sel = (confidence >= lo) & ((confidence < hi) if hi < 1.0 else (confidence <= hi))
+        n = int(sel.sum())
+        if n == 0:
+            continue
+        mean_c, share = float(confidence[sel].mean()), float(near[sel].mean())
+        counted = n >= min_samples
+        if counted:
+            worst = max(worst, abs(share - mean_c))
+        lines.append(f"  {lo:.1f}-{hi:.1f}   {n:>11} {mean_c:>9.3f} {share:>13.3f} {abs(share - mean_c):>6.3f}"
+                     + ("" if counted else "  (fewer than %d: not counted)" % min_samples))
+    lines.append(f"largest |share near a person - mean confidence| over bins with >= {min_samples} track-scans: "
+                 f"{worst:.3f} (target <= 0.1)")
+    return lines
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenes", nargs="+", default=["waiting_room", "crowd", "crossing", "stop_and_go", "occlusion",
+                                                     "following", "corridor"])
+    ap.add_argument("--seeds", nargs="+", type=int, default=None,
+                    help="seeds for waiting_room (default 21 22 23); other scenes use their own")
+    ap.add_argument("--duration", type=float, default=None, help="override every scene's duration, s")
+    ap.add_argument("--long-crowd", type=float, default=1200.0,
+                    help="also run crowd this long (s) when crowd is listed; 0 skips it")
+    args = ap.parse_args(argv)
+    runs = []
+    print(f"{'scene':<22} {'seed':>4} {'scans':>6} {'MOTA %':>7} {'IDF1 %':>7} {'IDsw':>5} {'FP':>6} {'misses':>7} "
+          f"{'ids/person':>10} {'false>=2s':>9}  reported/visible per minute")
+    jobs = []
+    for name in args.scenes:
+        if name == "waiting_room":
+            jobs += [(name, s, args.duration) for s in (args.seeds or [21, 22, 23])]
+        else:
+            jobs.append((name, None, args.duration))
+        if name == "crowd" and args.long_crowd > 0 and args.duration is None:
+            jobs.append((name, None, args.long_crowd))
+    for name, seed, duration in jobs:
+        run = run_scene(name, seed, duration)
+        f = scene_figures(run)
+        runs.append(f)
+        r = f["result"]
+        per_min = " ".join(f"{p:.1f}/{v:.1f}" for v, p in f["minutes"])
+        label = name if duration is None else f"{name} {duration:g}s"
+        print(f"{label:<22} {seed if seed is not None else '-':>4} {len(run.truths):>6} {100 * r['mota']:>7.1f} "
+              f"{100 * r['idf1']:>7.1f} {r['id_switches']:>5} {r['false_positives']:>6} {r['misses']:>7} "
+              f"{f['ids_per_person']:>10} {f['false_lasting']:>9}  {per_min}", flush=True)
+    conf = np.concatenate([f["confidence"] for f in runs]) if runs else np.zeros(0)
+    near = np.concatenate([f["near"] for f in runs]) if runs else np.zeros(0, dtype=bool)
+    print("\ncalibration of confidence over every run above (share of reported track-scans within "
+          f"{NEAR_M} m of a person):")
+    print("\n".join(calibration_table(conf, near)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
