@@ -50,3 +50,89 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
         hidden[inside] = moving[beam[inside]]
         free |= hidden & np.isfinite(r) & (r < dist - margin_m)
     return inside & free
+
+
+UNSEEN, OCCLUDED, OCCUPIED, SEEN_THROUGH = 0, 1, 2, 3
+
+
+def place_visibility(points_world: np.ndarray, scan: Scan, pose: Pose2D, radius_m: float,
+                     no_return_free_m: float = np.inf) -> np.ndarray:
+    """What ``scan`` (taken at ``pose``) saw of a disc of ``radius_m`` around each place.
+
+    Returns one code per place (int8): ``SEEN_THROUGH`` when at least half the beams across
+    the disc returned and every return lies beyond it (or a beam had no return and
+    ``no_return_free_m`` reaches past it): nobody stands there; ``OCCUPIED`` when a return
+    lies inside it; ``OCCLUDED`` when something nearer hides it; ``UNSEEN`` when it is
+    outside the field of view or too few beams returned (lost readings tell nothing).
+
+    Parameters
+    ----------
+    points_world : ndarray, shape (k, 2)
+        Places in the world frame, metres.
+    """
+    out = np.full(len(points_world), UNSEEN, dtype=np.int8)
+    if len(points_world) == 0:
+        return out
+    local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
+    dist = np.hypot(local[:, 0], local[:, 1])
+    centre = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
+    inc = abs(scan.angle_increment)
+    for k in np.flatnonzero((centre >= 0) & (dist > radius_m)):
+        half = int(np.ceil(np.arcsin(min(1.0, radius_m / dist[k])) / inc))
+        lo, hi = max(0, centre[k] - half), min(scan.n_beams, centre[k] + half + 1)
+        r = scan.ranges[lo:hi]
+        valid = scan.valid[lo:hi]
+        free = scan.no_return[lo:hi] & (dist[k] + radius_m <= no_return_free_m)
+        rv = r[valid]
+        if (np.abs(rv - dist[k]) <= radius_m).any():
+            out[k] = OCCUPIED
+        elif (rv < dist[k] - radius_m).any():
+            out[k] = OCCLUDED
+        elif valid.sum() + free.sum() >= 0.5 * (hi - lo):
+            out[k] = SEEN_THROUGH
+    return out
+
+
+class PlaceMemory:
+    """What the laser saw of each place over the last minutes: sparse keyframes (one scan
+    every ``keyframe_s`` seconds, ``memory_s`` seconds of them) and their sensor poses.
+
+    It answers whether a place was ever seen empty, or only ever seen occupied, before a
+    given time: someone who walked in and stopped stands where the laser once saw through;
+    a table leg stands where it was occupied from the first scan on.
+    """
+
+    EMPTY, OCCUPIED_ONLY, UNKNOWN = "empty", "occupied", "unknown"
+
+    def __init__(self, keyframe_s: float = 1.0, memory_s: float = 600.0) -> None:
+        from collections import deque
+        self.keyframe_s = keyframe_s
+        self._frames: deque = deque(maxlen=max(1, int(round(memory_s / keyframe_s))) if keyframe_s > 0 else 1)
+
+    def add(self, scan: Scan, pose: Pose2D) -> None:
+        """Offer a scan (sensor pose in the world frame); kept when a keyframe is due."""
+        if self.keyframe_s <= 0:
+            return
+        if not self._frames or scan.stamp - self._frames[-1][0].stamp >= self.keyframe_s or \
+                scan.stamp < self._frames[-1][0].stamp:
+            self._frames.append((scan, pose))
+
+    def history(self, xy_world: np.ndarray, before_s: float, radius_m: float,
+                no_return_free_m: float = np.inf, min_occupied_s: float = 10.0) -> str:
+        """``EMPTY`` when a keyframe older than ``before_s`` (a stamp, s) saw through the disc
+        of ``radius_m`` around the place, else ``OCCUPIED_ONLY`` when keyframes worth at
+        least ``min_occupied_s`` of time saw a return in it (a person passing by does not
+        make a place occupied), else ``UNKNOWN`` (never in view, or mostly hidden)."""
+        occupied = 0
+        point = np.asarray(xy_world, dtype=float).reshape(1, 2)
+        for scan, pose in self._frames:
+            if scan.stamp >= before_s:
+                break
+            code = place_visibility(point, scan, pose, radius_m, no_return_free_m)[0]
+            if code == SEEN_THROUGH:
+                return self.EMPTY
+            occupied += code == OCCUPIED
+        return self.OCCUPIED_ONLY if occupied * self.keyframe_s >= min_occupied_s else self.UNKNOWN
+
+    def reset(self) -> None:
+        self._frames.clear()

@@ -82,6 +82,15 @@ class LegModel:
         leaf = node - (feature.shape[1])  # leaves follow the inner nodes
         return self.init + leaves.ravel()[(np.arange(n_trees) * leaves.shape[1])[None, :] + leaf].sum(axis=1)
 
+    @property
+    def base_rate(self) -> float:
+        """Share of legs among the candidates the model was fitted on: the probability it
+        gives when the shape says nothing (to turn its scores into likelihood ratios)."""
+        if "base_rate" in self.meta:
+            return float(self.meta["base_rate"])
+        pos, neg = self.meta.get("positives"), self.meta.get("negatives")
+        return float(pos) / (pos + neg) if pos and neg else 0.5
+
     def probability(self, x: np.ndarray) -> np.ndarray:
         """Calibrated probability that each row of ``x`` is a leg, shape (k,)."""
         return np.interp(self.log_odds(x), self.calib_raw, self.calib_p)

@@ -100,17 +100,48 @@ class TracksConfig:
 
     accel_std_mps2: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
     init_speed_std_mps: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
-    confirm_hits: int = field(metadata=_spec(lo=1, hi=1000))
-    confirm_window: int = field(metadata=_spec(lo=1, hi=1000))
-    max_coast_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3600.0))
-    max_static_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=86400.0))
     max_position_std_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
     confirm_min_travel_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
     max_tentative_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3600.0))
+    still_after_s: float = field(metadata=_spec(lo=0.0, hi=3600.0))
+    still_drift_mps: float = field(metadata=_spec(lo=0.0, hi=100.0))
+    min_person_separation_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
 
     def params(self):
         from people_tracker.tracker.tracks import TrackParams
         return _params_of(self, TrackParams)
+
+
+@dataclass(frozen=True)
+class ExistenceConfig:
+    """Existence probability of a track; see :class:`people_tracker.tracker.existence.ExistenceParams`."""
+
+    prior_moving: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1.0))
+    prior_standing: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1.0))
+    arrived_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    motion_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    present_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    seen_through_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    independent_s: float = field(metadata=_spec(lo=0.0, hi=60.0))
+    shape_time_s: float = field(metadata=_spec(lo=0.0, hi=3600.0))
+    min_shape_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    max_shape_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    max_evidence_probability: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1.0))
+    confirm: float = field(metadata=_spec(lo=0.0, hi=1.0))
+    keep: float = field(metadata=_spec(lo=0.0, hi=1.0))
+    delete: float = field(metadata=_spec(lo=0.0, hi=1.0))
+    place_radius_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    furniture_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    place_keyframe_s: float = field(metadata=_spec(lo=0.0, hi=3600.0))
+    place_memory_s: float = field(metadata=_spec(lo=0.0, hi=86400.0))
+    place_before_s: float = field(metadata=_spec(lo=0.0, hi=3600.0))
+    unseen_half_life_s: float = field(metadata=_spec(lo=0.0, hi=86400.0))
+    report_unseen_s: float = field(metadata=_spec(lo=0.0, hi=86400.0))
+    motion_miss_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+
+    def params(self):
+        from people_tracker.tracker.existence import ExistenceParams
+        return _params_of(self, ExistenceParams)
 
 
 @dataclass(frozen=True)
@@ -201,6 +232,7 @@ class Config:
     detector: DetectorConfig
     pairing: PairingConfig
     tracks: TracksConfig
+    existence: ExistenceConfig
     association: AssociationConfig
     standing: StandingConfig
     legs: LegsConfig
@@ -270,7 +302,7 @@ def _check_value(name: str, value: Any, typ: type, spec: dict) -> Any:
 
 # pairs of keys of one section where the first must not exceed the second (besides every
 # min_X and max_X, found by name)
-_ORDERED = (("confirm_hits", "confirm_window"), ("confirm_scans", "confirm_window"))
+_ORDERED = (("confirm_scans", "confirm_window"), ("delete", "keep"), ("keep", "confirm"))
 
 
 def _check_order(values: dict, where: str) -> None:

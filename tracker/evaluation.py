@@ -13,6 +13,13 @@ Protocols (Leigh et al.):
 Every scan is a frame, including scans where nobody is annotated (a reported person
 there is a false positive). Positions are compared in the sensor frame.
 
+Hidden people (simulated scenes, where the simulator knows who is there but out of sight,
+fewer than 3 points) follow the MOTChallenge convention for ignored ground truth: a track
+that lies within ``threshold`` of a hidden person, and is not needed for a visible one
+(a joint nearest assignment per frame), is left out of that frame: neither a match nor a
+false positive. A tracker that keeps an occluded person is not punished for it, and gets
+no credit either.
+
 A bearing window (Leigh et al.'s ``constrain_to_specific_angle``) drops the ground-truth
 people and the tracks whose sensor-frame bearing ``atan2(y, x)`` lies outside it before
 matching, in every frame. Their published moving-robot figures use −80°..12°: the part of
@@ -92,9 +99,31 @@ def ospa(gt_xy: np.ndarray, tr_xy: np.ndarray, cutoff: float, order: float) -> f
     return float((total / max(m, n)) ** (1.0 / order))
 
 
+def without_hidden(gt: GroundTruth, hidden: GroundTruth, tracks: TrackRows, threshold: float) -> tuple[TrackRows, int]:
+    """The tracks without those on hidden people (see the module docstring), and how many
+    track rows were left out."""
+    keep = np.ones(len(tracks), dtype=bool)
+    frames = max(int(tracks.scan_index.max(initial=-1)), int(hidden.scan_index.max(initial=-1))) + 1
+    g_rows, h_rows, t_rows = (_by_frame(a.scan_index, frames) for a in (gt, hidden, tracks))
+    for k in range(frames):
+        h, t = h_rows[k], t_rows[k]
+        if not len(h) or not len(t):
+            continue
+        g = g_rows[k]
+        people = np.vstack([np.column_stack([gt.x[g], gt.y[g]]), np.column_stack([hidden.x[h], hidden.y[h]])])
+        d = pairwise_distances(people, np.column_stack([tracks.x[t], tracks.y[t]]))
+        rows, cols = linear_sum_assignment(np.where(d <= threshold, d, 1e6))
+        for r, c in zip(rows, cols):
+            if r >= len(g) and d[r, c] <= threshold:
+                keep[t[c]] = False
+    out = replace(tracks, **{f.name: getattr(tracks, f.name)[keep] for f in fields(tracks)
+                             if isinstance(getattr(tracks, f.name), np.ndarray)})
+    return out, int((~keep).sum())
+
+
 def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", threshold: float = 0.75,
              ospa_cutoff: float = 1.0, ospa_order: float = 1.0, n_frames: int | None = None,
-             bearing_window_deg: tuple[float, float] | None = None) -> dict:
+             bearing_window_deg: tuple[float, float] | None = None, hidden: GroundTruth | None = None) -> dict:
     """Score ``tracks`` against ``gt``.
 
     Parameters
@@ -110,6 +139,8 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
         Number of frames; default ``gt.n_frames`` or the largest index seen plus one.
     bearing_window_deg : (float, float), optional
         Keep only people and tracks whose sensor-frame bearing lies in [min, max], degrees.
+    hidden : GroundTruth, optional
+        People who are there but hidden: tracks on them are ignored (see the module docstring).
 
     Returns
     -------
@@ -125,6 +156,9 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
     if protocol == "following" and tracks.target is not None:
         keep = tracks.target == 1
         tracks = TrackRows(tracks.scan_index[keep], tracks.track_id[keep], tracks.x[keep], tracks.y[keep], tracks.target[keep])
+    ignored = 0
+    if hidden is not None and len(hidden) and protocol == "general":
+        tracks, ignored = without_hidden(gt, hidden, tracks, threshold)
     if bearing_window_deg is not None:
         gt, tracks = _in_window(gt, bearing_window_deg), _in_window(tracks, bearing_window_deg)
     last = max(int(gt.scan_index.max(initial=-1)), int(tracks.scan_index.max(initial=-1)))
@@ -156,7 +190,8 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
         "threshold_m": threshold,
         "frames": int(frames),
         "ground_truth": n_gt,
-        "tracks_reported": int(len(tracks)),
+        "tracks_reported": int(len(tracks)) + ignored,
+        "tracks_on_hidden_people": ignored,
         "matches": int(row["num_detections"]),  # CLEAR MOT correspondences, switches included
         "misses": misses,
         "false_positives": fps,
@@ -190,7 +225,9 @@ def format_table(result: dict) -> str:
                    + ("" if result.get("bearing_window_deg") is None else
                       " (people and tracks with bearing {:g}°..{:g}° only)".format(*result["bearing_window_deg"]))),
         ("ground-truth people", f"{result['ground_truth']}"),
-        ("reported tracks", f"{result['tracks_reported']}"),
+        ("reported tracks", f"{result['tracks_reported']}"
+                            + (f" ({result['tracks_on_hidden_people']} on hidden people, ignored)"
+                               if result.get("tracks_on_hidden_people") else "")),
         ("matches", f"{result['matches']}"),
         ("misses", f"{result['misses']}"),
         ("false positives", f"{result['false_positives']}" + (" (not counted in MOTA)" if result["protocol"] == "following" else "")),

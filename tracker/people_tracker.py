@@ -17,12 +17,13 @@ import numpy as np
 
 from people_tracker.detection.align import Alignment, AlignParams, ScanAligner
 from people_tracker.detection.detector import Detection, DetectorParams, MovingObjectDetector
-from people_tracker.detection.free_space import seen_through
+from people_tracker.detection.free_space import SEEN_THROUGH, UNSEEN, PlaceMemory, place_visibility, seen_through
 from people_tracker.detection.leg_features import LegCandidates, leg_candidates
 from people_tracker.models.leg_model import LegModel, load_leg_model
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
 from people_tracker.tracker.association import associate, mahalanobis_costs
+from people_tracker.tracker.existence import Existence, ExistenceParams
 from people_tracker.tracker.following import TargetSelector
 from people_tracker.tracker.pairing import PairingParams, PersonCandidate, owners, pair_legs
 from people_tracker.tracker.standing import StandingInitiator, StandingParams, standing_pairs
@@ -96,7 +97,8 @@ class PeopleTracker:
     def __init__(self, detector: DetectorParams | None = None, pairing: PairingParams | None = None,
                  tracks: TrackParams | None = None, association: AssociationParams | None = None,
                  follow: str | int | None = None, alignment: AlignParams | None = None,
-                 standing: StandingParams | None = None, leg_model: LegModel | None = None) -> None:
+                 standing: StandingParams | None = None, leg_model: LegModel | None = None,
+                 existence: ExistenceParams | None = None) -> None:
         self.aligner = ScanAligner(alignment or AlignParams())
         self.detector = MovingObjectDetector(detector or DetectorParams())
         self.pairing = pairing or PairingParams()
@@ -105,6 +107,11 @@ class PeopleTracker:
         self.selector = TargetSelector(follow) if follow is not None else None
         self.standing = StandingInitiator(standing or StandingParams())
         self.leg_model = leg_model if leg_model is not None else load_leg_model()
+        self.existence = existence or ExistenceParams()
+        self.places = PlaceMemory(self.existence.place_keyframe_s, self.existence.place_memory_s)
+        self._stood: list[list] = []  # where people who walked in stand still: [xy (m), last stamp (s), id, l_dyn]
+        self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
+        self._leg_scores = np.zeros(0)  # ... and their leg probabilities
         self._tracks: list[TrackState] = []
         self._next_id = 1
         self.last: StepResult | None = None
@@ -115,13 +122,14 @@ class PeopleTracker:
         """A tracker from a resolved :class:`people_tracker.tracker.config.Config`."""
         return cls(config.detector.params(), config.pairing.params(), config.tracks.params(),
                    config.association.params(), follow, config.alignment.params(), config.standing.params(),
-                   config.legs.load())
+                   config.legs.load(), config.existence.params())
 
     def reset(self) -> None:
         """Forget the scan history (a stamp jump, a new scanner); tracks coast on."""
         self.detector.reset()
         self.aligner.reset()
         self.standing.reset()
+        self.places.reset()
 
     def step(self, scan: Scan, pose: Pose2D | None = None, pose_last_beam: Pose2D | None = None) -> list[Track]:
         """Process one scan; return the confirmed tracks (coasting ones included).
@@ -139,7 +147,7 @@ class PeopleTracker:
         pose, pose_last_beam = self._usable(pose, scan.stamp), self._usable(pose_last_beam, scan.stamp)
         if pose is None:
             pose_last_beam = None
-        people = np.array([t.position for t in self._tracks if t.confirmed]).reshape(-1, 2)
+        people = np.array([t.position for t in self._tracks if t.reported]).reshape(-1, 2)
         aligned = self.aligner.align(scan, pose, pose_last_beam, people)  # 0. de-skew and align
         scan, world = aligned.scan, aligned.pose
         # 1. moving objects (sensor frame)
@@ -155,18 +163,107 @@ class PeopleTracker:
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
         legs = leg_candidates(scan)  # 6. every leg candidate and its probability, by shape alone
         leg_scores = self.leg_model.probability(legs.features)
+        self._legs_world = world.transform_points(legs.xy) if len(legs.xy) else np.zeros((0, 2))
+        self._leg_scores = leg_scores
         standing = self._standing_candidates(legs, leg_scores, world)  # 6b. standing people: leg pairs
         matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
         self._support(scan, world, matched_t)  # 7. static support for the rest
-        for t in self._tracks:
-            t.record(t.updated_now)
+        self._weigh(scan, world)  # 7b. evidence of existence
+        self.places.add(scan, world)
+        self._remember_standing(scan, world)
+        self._reacquire_standing(scan, world)
         self._initiate(candidates, {ci for _, ci in matched}, scan.stamp)  # 8. new tentative tracks
         self._initiate_standing(standing, scan.stamp)  # 8b. and standing people who persist
         self._delete(scan.stamp)  # 9. delete what the lifecycle rules end
         target = self._follow(world, scan.stamp)  # 10. the followed person
-        reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.confirmed]
+        reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.reported]
         self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing, legs, leg_scores)
         return reported
+
+    def _best_leg(self, xy_world: np.ndarray) -> np.ndarray:
+        """The best leg probability among this scan's leg candidates within the support
+        radius of each place (world frame); nan where there is none."""
+        out = np.full(len(xy_world), np.nan)
+        if len(xy_world) and len(self._legs_world):
+            d = pairwise_distances(xy_world, self._legs_world)
+            near = d <= self.assoc.support_radius_m
+            scores = np.where(near, self._leg_scores[None, :], -1.0).max(axis=1)
+            out = np.where(near.any(axis=1), scores, np.nan)
+        return out
+
+    def _weigh(self, scan: Scan, world: Pose2D) -> None:
+        """Each track's existence evidence from this scan: its update, whether the scan saw
+        through its place, and the leg shape there."""
+        if not self._tracks:
+            return
+        xy = np.array([t.position for t in self._tracks])
+        best = self._best_leg(xy)
+        idle = np.array([not t.updated_now for t in self._tracks])
+        vis = np.full(len(xy), UNSEEN, dtype=np.int8)
+        if idle.any():
+            vis[idle] = place_visibility(xy[idle], scan, world, self.existence.place_radius_m,
+                                         self.detector.params.no_return_free_m)
+        for t in self._tracks:  # where a track came to stand still: was the place ever empty?
+            if t.place is None and t.moved and t.still:
+                t.place = self._place_history(t.position, t.last_moving_update)
+        for t, b, v in zip(self._tracks, best, vis):
+            # nothing leg-like where something person-like updated it: a shape of 0
+            leg = float(b) if b == b else (0.0 if t.updated_now else None)
+            t.weigh(int(v), leg)
+
+    def _remember_standing(self, scan: Scan, world: Pose2D) -> None:
+        """Remember where reported people who walked in stand still (world frame), with their
+        id and evidence, until the place is seen empty or ``place_memory_s`` has passed."""
+        stamp = scan.stamp
+        stood = self._stood
+        if stood:
+            xy = np.array([e[0] for e in stood])
+            vis = place_visibility(xy, scan, world, self.existence.place_radius_m, self.detector.params.no_return_free_m)
+            stood = [e for e, v in zip(stood, vis) if v != SEEN_THROUGH and e[1] >= stamp - self.existence.place_memory_s]
+        for t in self._tracks:
+            if t.reported and t.moved and t.still and t.place != PlaceMemory.OCCUPIED_ONLY:
+                for e in stood:
+                    if e[2] == t.track_id or np.hypot(*(e[0] - t.position)) <= self.assoc.support_anchor_m:
+                        e[0], e[1], e[2], e[3] = t.position.copy(), stamp, t.track_id, t.existence.l_dyn
+                        break
+                else:
+                    stood.append([t.position.copy(), stamp, t.track_id, t.existence.l_dyn])
+        self._stood = stood[-1000:]
+
+    def _reacquire_standing(self, scan: Scan, world: Pose2D) -> None:
+        """A person-sized object where someone stood, and no track there: that person, seen
+        again after their track was lost (someone walked between, the track went with the
+        passer-by). They get their id back when it is free, and their evidence."""
+        if not self._stood:
+            return
+        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
+        lost = [e for e in self._stood if not len(known) or
+                np.hypot(*(known - e[0]).T).min() >= self.assoc.spawn_exclusion_m]
+        if not lost:
+            return
+        d = self.detector.params
+        found = static_support(np.array([e[0] for e in lost]), world, scan, d.k_segment, d.segment_floor_m,
+                               self.assoc.support_radius_m, self.pairing.max_person_size_m, self.assoc.support_min_points)
+        used = {t.track_id for t in self._tracks}
+        R = np.eye(2) * self.assoc.support_sigma_m ** 2
+        for e, z in zip(lost, found):
+            if z is None or np.hypot(*(z - e[0])) > self.assoc.support_anchor_m:
+                continue
+            ex = Existence(self.existence, scan.stamp, True, True, None, self.leg_model.base_rate)
+            ex.l_dyn = e[3]
+            track_id = e[2] if e[2] not in used else self._next_id
+            if track_id == self._next_id:
+                self._next_id += 1
+            t = TrackState(track_id, float(z[0]), float(z[1]), R, scan.stamp, self.track_params, ex, standing=True)
+            t.confirmed, t.moved, t.place = True, True, PlaceMemory.UNKNOWN
+            t.last_moving_update = t.last_update - self.track_params.still_after_s  # standing still
+            self._tracks.append(t)
+            used.add(track_id)
+            e[2] = track_id
+
+    def _place_history(self, xy: np.ndarray, since: float) -> str:
+        e = self.existence
+        return self.places.history(xy, since - e.place_before_s, e.place_radius_m, self.detector.params.no_return_free_m)
 
     def _usable(self, pose: Pose2D | None, stamp: float) -> Pose2D | None:
         """The pose, or None when it is not finite (counted; the first one is a warning)."""
@@ -184,8 +281,9 @@ class PeopleTracker:
         if not objs:
             return []
         xy = world.transform_points(np.array([(o.x, o.y) for o in objs]))
-        # legs near a tracked person are that person's: never paired with another person's
-        people = np.array([t.position for t in self._tracks if t.confirmed]).reshape(-1, 2)
+        # legs near a tracked walking person are that person's: never paired with another
+        # person's. A person standing still owns no moving legs: those are a passer-by's.
+        people = np.array([t.position for t in self._tracks if t.confirmed and not t.still]).reshape(-1, 2)
         groups = owners(xy, people, 0.5 * self.pairing.max_leg_separation_m)
         return pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups)
 
@@ -252,7 +350,7 @@ class PeopleTracker:
 
     def _update_standing(self, standing: list[PersonCandidate]) -> set[int]:
         """Standing pairs update confirmed tracks no moving candidate reached; their indices."""
-        idle = [i for i, t in enumerate(self._tracks) if t.confirmed and not t.updated_now]
+        idle = [i for i, t in enumerate(self._tracks) if (t.confirmed or t.born_standing) and not t.updated_now]
         if not idle or not standing:
             return set()
         means = np.array([self._tracks[i].position for i in idle])
@@ -274,15 +372,41 @@ class PeopleTracker:
             return
         xy = np.array([(c.x, c.y) for c in standing]).reshape(-1, 2)
         persistent = self.standing.persistent(xy)
-        self._spawn([standing[k] for k in np.flatnonzero(persistent)], stamp, standing=True)
+        chosen = [standing[k] for k in np.flatnonzero(persistent)]
+        xy = np.array([(c.x, c.y) for c in chosen]).reshape(-1, 2)
+        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
+        if len(known) and len(xy):  # those the spawn rule would turn away need no history
+            keep = pairwise_distances(xy, known).min(axis=1) >= self.assoc.spawn_exclusion_m
+            chosen, xy = [c for c, k in zip(chosen, keep) if k], xy[keep]
+        places = [self._place_history(p, stamp) for p in xy]
+        arrived = self._seen_empty(xy, stamp) | np.array([p == PlaceMemory.EMPTY for p in places], dtype=bool)
+        self._spawn(chosen, stamp, standing=True, arrived=arrived, places=places)
 
-    def _spawn(self, candidates: list[PersonCandidate], stamp: float, standing: bool = False) -> None:
+    def _seen_empty(self, xy: np.ndarray, stamp: float) -> np.ndarray:
+        """Whether a scan about ½, 1 or 1½ free-space lookbacks ago saw past each place."""
+        seen = np.zeros(len(xy), dtype=bool)
+        lookback = self.assoc.free_space_lookback_s
+        if len(xy) == 0 or lookback <= 0:
+            return seen
+        for scan, pose, moving in self.detector.earlier_scans(stamp, (0.5 * lookback, lookback, 1.5 * lookback)):
+            seen |= seen_through(xy, scan, pose, self.assoc.free_space_margin_m, moving,
+                                 self.detector.params.no_return_free_m)
+        return seen
+
+    def _spawn(self, candidates: list[PersonCandidate], stamp: float, standing: bool = False,
+               arrived: np.ndarray | None = None, places: list[str] | None = None) -> None:
         """A new track for each candidate not within the spawn exclusion of any track."""
         known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
-        for c in candidates:
+        best = self._best_leg(np.array([(c.x, c.y) for c in candidates]).reshape(-1, 2))
+        base = self.leg_model.base_rate
+        for k, c in enumerate(candidates):
             if len(known) and np.hypot(*(known - (c.x, c.y)).T).min() < self.assoc.spawn_exclusion_m:
                 continue
-            self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params, standing))
+            ex = Existence(self.existence, stamp, standing, bool(arrived[k]) if arrived is not None else True,
+                           None if best[k] != best[k] else float(best[k]), base)
+            self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params, ex, standing))
+            if places is not None:
+                self._tracks[-1].place = places[k]
             known = np.vstack([known, [c.x, c.y]])
             self._next_id += 1
 
@@ -290,20 +414,38 @@ class PeopleTracker:
         fresh = [ci for ci in range(len(candidates)) if ci not in used]
         free = np.ones(len(candidates), dtype=bool)
         if fresh and self.assoc.free_space_lookback_s > 0:
-            xy = np.array([(candidates[ci].x, candidates[ci].y) for ci in fresh])
-            seen = np.zeros(len(fresh), dtype=bool)
-            lookback = self.assoc.free_space_lookback_s
-            for scan, pose, moving in self.detector.earlier_scans(stamp, (0.5 * lookback, lookback, 1.5 * lookback)):
-                seen |= seen_through(xy, scan, pose, self.assoc.free_space_margin_m, moving,
-                                     self.detector.params.no_return_free_m)
-            free[fresh] = seen
+            free[fresh] = self._seen_empty(np.array([(candidates[ci].x, candidates[ci].y) for ci in fresh]), stamp)
         self._spawn([c for ci, c in enumerate(candidates) if ci not in used and free[ci]], stamp)
+
+    def _duplicates(self) -> set[int]:
+        """Indices of tracks that slid onto a person standing still who has a track already.
+
+        Two people's torsos are never closer than ``tracks.min_person_separation_m``; when a
+        track comes that close to one standing still, it is the same person twice: the one
+        that stood there longer keeps the place (with both still, the older track)."""
+        sep = self.track_params.min_person_separation_m
+        idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
+        if len(idx) < 2 or sep <= 0:
+            return set()
+        xy = np.array([self._tracks[i].position for i in idx])
+        d = pairwise_distances(xy, xy)
+        out = set()
+        for a, b in zip(*np.nonzero(np.triu(d < sep, k=1))):
+            ta, tb = self._tracks[idx[a]], self._tracks[idx[b]]
+            if not (ta.still or tb.still) or idx[a] in out or idx[b] in out:
+                continue
+            if ta.still != tb.still:
+                out.add(idx[b] if ta.still else idx[a])
+            else:
+                out.add(idx[b] if ta.born <= tb.born else idx[a])
+        return out
 
     def _delete(self, stamp: float) -> None:
         keep = []
-        for t in self._tracks:
-            if t.dead():
-                if t.furniture():
+        duplicates = self._duplicates()
+        for i, t in enumerate(self._tracks):
+            if i in duplicates or t.dead():
+                if t.furniture() and t.existence.probability >= self.existence.delete:
                     self.standing.furniture(t.position)
                 if self.selector is not None and t.track_id == self.selector.target:
                     self.selector.lost(stamp, t.position)
@@ -314,16 +456,16 @@ class PeopleTracker:
     def _follow(self, world: Pose2D, stamp: float) -> int | None:
         if self.selector is None:
             return None
-        confirmed = {t.track_id: t.position for t in self._tracks if t.confirmed}
+        confirmed = {t.track_id: t.position for t in self._tracks if t.reported}
         if self.selector.target is not None and self.selector.target not in confirmed:
             young = {t.track_id: t.position for t in self._tracks
-                     if t.confirmed and t.track_id > self.selector.target and stamp - t.born < 2.0}
+                     if t.reported and t.track_id > self.selector.target and stamp - t.born < 2.0}
             new_id = self.selector.reacquire(stamp, young)
             if new_id is not None:
                 for t in self._tracks:
                     if t.track_id == new_id:
                         t.track_id = self.selector.target  # the person keeps their id
-                confirmed = {t.track_id: t.position for t in self._tracks if t.confirmed}
+                confirmed = {t.track_id: t.position for t in self._tracks if t.reported}
         return self.selector.choose(confirmed, world)
 
 

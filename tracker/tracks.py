@@ -4,13 +4,13 @@ world frame, and its lifecycle (tentative → confirmed → coasting → deleted
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
 from people_tracker.models.motion import H, constant_velocity_FQ
+from people_tracker.tracker.existence import Existence, logit
 
 
 @dataclass(frozen=True)
@@ -23,31 +23,33 @@ class TrackParams:
         White-noise acceleration of a walking person, m/s² (process noise).
     init_speed_std_mps : float
         Uncertainty of a new track's velocity, m/s.
-    confirm_hits, confirm_window : int
-        A tentative track is confirmed after ``confirm_hits`` updates within its last
-        ``confirm_window`` scans, and deleted when it can no longer reach that.
-    max_coast_s : float
-        A confirmed track with no update for this long is deleted.
-    max_static_s : float
-        A track kept only by static support (a paused person) for this long is deleted.
     max_position_std_m : float
         A track whose position uncertainty (1σ, largest axis) grows beyond this is deleted.
     confirm_min_travel_m : float
-        A tentative track is confirmed only once it is this far from where it started:
+        A track born moving is confirmed only once it is this far from where it started:
         people walk, clutter that the detector flags now and then does not.
     max_tentative_s : float
         A track still tentative after this long is deleted.
+    still_after_s : float
+        A track updated by static evidence alone for this long after its last moving
+        update is a person standing still: its velocity is zero and its position drifts
+        only by ``still_drift_mps``, s.
+    still_drift_mps : float
+        How fast a standing person's position may wander unseen (occluded), m/s (the
+        standard deviation grows as this times the square root of the time, in seconds).
+    min_person_separation_m : float
+        Two people's torsos are never closer than this, metres: a track that comes this
+        close to one standing still is that person twice, and the newcomer is deleted.
     """
 
     accel_std_mps2: float = 1.5
     init_speed_std_mps: float = 1.0
-    confirm_hits: int = 3
-    confirm_window: int = 5
-    max_coast_s: float = 1.5
-    max_static_s: float = 10.0
     max_position_std_m: float = 1.0
     confirm_min_travel_m: float = 0.4
     max_tentative_s: float = 2.0
+    still_after_s: float = 1.0
+    still_drift_mps: float = 0.1
+    min_person_separation_m: float = 0.35
 
 
 @dataclass(frozen=True)
@@ -55,7 +57,8 @@ class Track:
     """A reported track at one scan (world frame, metres, m/s).
 
     ``status`` is ``tentative``, ``confirmed`` or ``coasting`` (confirmed, not updated by
-    this scan); ``confidence`` in [0, 1]; ``target`` marks the followed person.
+    this scan); ``confidence`` is the probability that a person is there (see
+    :mod:`people_tracker.tracker.existence`); ``target`` marks the followed person.
     """
 
     track_id: int
@@ -74,7 +77,7 @@ class TrackState:
     """The mutable state of one track (internal to the tracker)."""
 
     def __init__(self, track_id: int, x: float, y: float, R: np.ndarray, stamp: float, params: TrackParams,
-                 standing: bool = False) -> None:
+                 existence: Existence, standing: bool = False) -> None:
         self.track_id = track_id
         self.params = params
         kf = KalmanFilter(dim_x=4, dim_z=2)
@@ -87,13 +90,13 @@ class TrackState:
         self.last_update = stamp
         self.last_moving_update = stamp
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
-        self.hits: deque[bool] = deque([True], maxlen=params.confirm_window)
         self.origin = np.array([x, y])
-        # a standing person is confirmed by the persistence of their legs (see tracker.standing)
-        self.confirmed = standing or (params.confirm_hits <= 1 and params.confirm_min_travel_m <= 0)
+        self.existence = existence
+        self.confirmed = False
         self.born_standing = standing
         self.moved = not standing  # has a moving candidate ever updated it
-        self.updated_now = True
+        self.update_kind: str | None = "static" if standing else "moving"  # how this scan updated it
+        self.place: str | None = None  # PlaceMemory's verdict on where it stands still (None: not judged)
 
     @property
     def position(self) -> np.ndarray:
@@ -105,15 +108,27 @@ class TrackState:
         """Its 2x2 covariance, m²."""
         return self.kf.P[::2, ::2]
 
+    @property
+    def updated_now(self) -> bool:
+        return self.update_kind is not None
+
     def predict(self, stamp: float) -> None:
-        """Move the state to ``stamp`` (s) with the constant-velocity model."""
+        """Move the state to ``stamp`` (s): constant velocity, or standing still."""
         dt = stamp - self.stamp
         if dt > 0:
-            F, Q = constant_velocity_FQ(dt, self.params.accel_std_mps2 ** 2)
-            # x = F x ;  P = F P Fᵀ + Q
-            self.kf.predict(F=F, Q=Q)
+            if self.still:
+                # a standing person: no velocity; the position wanders slowly
+                self.kf.x[1] = self.kf.x[3] = 0.0
+                self.forget_velocity()
+                d = self.params.still_drift_mps ** 2 * dt
+                self.kf.P[0, 0] += d
+                self.kf.P[2, 2] += d
+            else:
+                F, Q = constant_velocity_FQ(dt, self.params.accel_std_mps2 ** 2)
+                # x = F x ;  P = F P Fᵀ + Q
+                self.kf.predict(F=F, Q=Q)
             self.stamp = stamp
-        self.updated_now = False
+        self.update_kind = None
 
     def forget_velocity(self) -> None:
         """Reset the velocity's uncertainty to a new track's (after a sharp turn)."""
@@ -132,25 +147,42 @@ class TrackState:
             self.moved = True
             self.last_moving_update = self.stamp
             self.moving_position = self.position.copy()
-        self.updated_now = True
+            self.update_kind = "moving"
+            self.place = None
+        elif self.update_kind is None:
+            self.update_kind = "static"
 
-    def record(self, hit: bool) -> None:
-        """Book one scan's outcome; confirm when enough hits fall in the window."""
-        self.hits.append(hit)
-        if (not self.confirmed and sum(self.hits) >= self.params.confirm_hits
-                and np.hypot(*(self.position - self.origin)) >= self.params.confirm_min_travel_m):
+    @property
+    def still(self) -> bool:
+        """Seen standing still: never moved, or updated by static evidence alone (leg pairs,
+        static support) for ``still_after_s`` since its last moving update. Someone who
+        walks out of sight is not standing still: they keep their velocity."""
+        return not self.moved or self.last_update - self.last_moving_update >= self.params.still_after_s
+
+    def weigh(self, visibility: int, leg_probability: float | None) -> None:
+        """Book this scan's evidence of existence; confirm when it is strong enough."""
+        self.existence.update(self.stamp, self.update_kind, visibility, leg_probability,
+                              self.still and self.place == "occupied", walking=self.moved and not self.still)
+        if (not self.confirmed and self.existence.probability >= self.existence.params.confirm
+                and (self.born_standing or
+                     np.hypot(*(self.position - self.origin)) >= self.params.confirm_min_travel_m)):
             self.confirmed = True
 
+    @property
+    def reported(self) -> bool:
+        """Confirmed, likely enough, and seen lately enough to be reported."""
+        e = self.existence.params
+        return self.confirmed and self.existence.probability >= e.keep and \
+            self.stamp - self.last_update <= e.report_unseen_s
+
     def dead(self) -> bool:
-        """Whether the lifecycle rules delete this track now."""
-        p = self.params
-        if not self.confirmed:
-            # too few updates in its window, or it has not gone anywhere in time
-            return (len(self.hits) == p.confirm_window and sum(self.hits) < p.confirm_hits) or \
-                self.stamp - self.born > p.max_tentative_s
-        if self.stamp - self.last_update > p.max_coast_s:
+        """Whether this track ends now: unlikely, lost, or tentative too long."""
+        p, e = self.params, self.existence
+        if self.confirmed and e.probability < e.params.delete:
             return True
-        if self.stamp - self.last_moving_update > p.max_static_s:
+        # a tentative track's shape is not yet known well: it ends by time, or by evidence
+        # of absence alone
+        if not self.confirmed and (self.stamp - self.born > p.max_tentative_s or e.l_dyn <= logit(e.params.delete)):
             return True
         (a, b), (_, c) = self.position_cov
         # largest eigenvalue of the 2x2 covariance [[a, b], [b, c]]
@@ -163,17 +195,13 @@ class TrackState:
         return not self.moved or self.last_update > self.last_moving_update
 
     def furniture(self) -> bool:
-        """Born standing, never moved, and ended by ``max_static_s``: not a person."""
-        return self.born_standing and not self.moved and self.stamp - self.born > self.params.max_static_s
-
-    def confidence(self) -> float:
-        """Share of recent scans with an update, faded by the time since the last one."""
-        share = sum(self.hits) / self.params.confirm_window
-        return float(min(1.0, share) * math.exp(-(self.stamp - self.last_update) / self.params.max_coast_s))
+        """Born standing, never moved, its place never seen empty, never confirmed: not a person."""
+        return self.born_standing and not self.moved and not self.confirmed and \
+            not self.existence.walked_or_arrived
 
     def report(self, target: bool = False) -> Track:
         x, vx, y, vy = (float(v) for v in self.kf.x)
         cov = self.position_cov
         status = "tentative" if not self.confirmed else ("confirmed" if self.updated_now else "coasting")
         return Track(self.track_id, x, y, vx, vy, ((float(cov[0, 0]), float(cov[0, 1])), (float(cov[1, 0]), float(cov[1, 1]))),
-                     status, self.confidence(), self.stamp - self.born, target)
+                     status, self.existence.probability, self.stamp - self.born, target)

@@ -64,7 +64,7 @@ def test_missing_file():
     ({"pairing": {"min_leg_size_m": 0.5}}, "'pairing.min_leg_size_m' (0.5) must not exceed 'pairing.max_leg_size_m'"),
     ({"standing": {"min_leg_separation_m": 0.9}}, "'standing.min_leg_separation_m'"),
     ({"alignment": {"min_correspondence_m": 0.9}}, "'alignment.min_correspondence_m'"),
-    ({"tracks": {"confirm_hits": 6}}, "'tracks.confirm_hits' (6) must not exceed 'tracks.confirm_window' (5)"),
+    ({"existence": {"keep": 0.9}}, "'existence.keep' (0.9) must not exceed 'existence.confirm' (0.7)"),
 ])
 def test_every_minimum_is_at_most_its_maximum(override, words):
     from people_tracker.tracker.config import config_from_dict

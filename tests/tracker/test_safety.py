@@ -134,7 +134,7 @@ def test_a_folder_named_like_a_scenario_does_not_hide_it(tmp_path):
 def test_config_names_a_shipped_file_unless_it_looks_like_a_path(tmp_path):
     assert run_cli("run", "--config", "moving_robot", cwd=tmp_path).returncode == 0
     one_line_error(run_cli("run", "--config", "moving_robt", cwd=tmp_path), "no shipped configuration", "moving_robot")
-    (tmp_path / "mine.yaml").write_text("tracks: {confirm_hits: 4}\n")
+    (tmp_path / "mine.yaml").write_text("tracks: {max_tentative_s: 3.0}\n")
     assert run_cli("run", "--config", "mine.yaml", cwd=tmp_path).returncode == 0
     one_line_error(run_cli("run", "--config", "./nothere", cwd=tmp_path), "does not exist")
 
