@@ -295,13 +295,17 @@ class PeopleTracker:
         z = np.array([(c.x, c.y) for c in candidates])
         R = np.array([c.R for c in candidates])
         cost = mahalanobis_costs(means, covs, z, R)
-        # a person held still (standing, paused) walks off from where they stood: however wide
-        # their gate has grown, a moving candidate must lie near that place
-        still = np.array([t.held_still for t in self._tracks])
+        # someone seen standing still sets off from where they stand, with a leg beside them:
+        # anything moving farther away is somebody else passing by (or facing them). One
+        # never seen moving (found standing) sets off from where they were found.
+        still = np.array([t.still for t in self._tracks])
         if still.any():
-            anchors = np.array([t.moving_position for t in self._tracks])
-            away = pairwise_distances(anchors, z) > self.assoc.recover_radius_m
-            cost[still[:, None] & away] = np.inf
+            moved = np.array([t.moved for t in self._tracks])
+            d_here = pairwise_distances(means, z)
+            d_found = pairwise_distances(np.array([t.moving_position for t in self._tracks]), z)
+            far = np.where(moved[:, None], d_here > self.track_params.min_person_separation_m,
+                           d_found > self.assoc.recover_radius_m)
+            cost[still[:, None] & far] = np.inf
         # confirmed tracks choose first: a tentative track never takes a confirmed one's candidate
         confirmed = np.array([t.confirmed for t in self._tracks])
         pairs = associate(np.where(confirmed[:, None], cost, np.inf), self.assoc.gate_chi2, self.assoc.method)
@@ -331,9 +335,19 @@ class PeopleTracker:
         if not idle:
             return
         d = self.detector.params
-        found = static_support(np.array([self._tracks[i].position for i in idle]), world, scan, d.k_segment,
-                               d.segment_floor_m, self.assoc.support_radius_m, self.pairing.max_person_size_m,
-                               self.assoc.support_min_points)
+
+        def support(places: np.ndarray) -> list[np.ndarray | None]:
+            return static_support(places, world, scan, d.k_segment, d.segment_floor_m, self.assoc.support_radius_m,
+                                  self.pairing.max_person_size_m, self.assoc.support_min_points)
+
+        found = support(np.array([self._tracks[i].position for i in idle]))
+        # someone who stops stands where their legs were last seen moving, while the
+        # prediction walks on: look there too
+        again = [k for k, z in enumerate(found) if z is None and
+                 np.hypot(*(self._tracks[idle[k]].position - self._tracks[idle[k]].moving_position)) > 0.1]
+        if again:
+            for k, z in zip(again, support(np.array([self._tracks[idle[k]].moving_position for k in again]))):
+                found[k] = z
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
         for i, z in zip(idle, found):
             t = self._tracks[i]
@@ -440,17 +454,27 @@ class PeopleTracker:
                 out.add(idx[b] if ta.born <= tb.born else idx[a])
         return out
 
+    def _hand_over(self, t: TrackState, living: list[TrackState], stamp: float) -> bool:
+        """A person who stood still and set off: their place empties (the standing track
+        dies) while a new track starts beside it, which takes the standing one's id."""
+        if not (t.confirmed and t.moved and t.still):
+            return False
+        young = [u for u in living if stamp - u.born <= 3.0 and u.track_id > t.track_id and
+                 np.hypot(*(u.origin - t.position)) <= self.assoc.recover_radius_m]
+        if not young:
+            return False
+        min(young, key=lambda u: np.hypot(*(u.origin - t.position))).track_id = t.track_id
+        return True
+
     def _delete(self, stamp: float) -> None:
-        keep = []
         duplicates = self._duplicates()
-        for i, t in enumerate(self._tracks):
-            if i in duplicates or t.dead():
-                if t.furniture() and t.existence.probability >= self.existence.delete:
-                    self.standing.furniture(t.position)
-                if self.selector is not None and t.track_id == self.selector.target:
-                    self.selector.lost(stamp, t.position)
-                continue
-            keep.append(t)
+        dying = [t for i, t in enumerate(self._tracks) if i not in duplicates and t.dead()]
+        keep = [t for i, t in enumerate(self._tracks) if i not in duplicates and not (t in dying)]
+        for t in dying:
+            if t.furniture() and t.existence.probability >= self.existence.delete:
+                self.standing.furniture(t.position)
+            if not self._hand_over(t, keep, stamp) and self.selector is not None and t.track_id == self.selector.target:
+                self.selector.lost(stamp, t.position)
         self._tracks = keep
 
     def _follow(self, world: Pose2D, stamp: float) -> int | None:

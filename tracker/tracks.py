@@ -39,7 +39,8 @@ class TrackParams:
         standard deviation grows as this times the square root of the time, in seconds).
     min_person_separation_m : float
         Two people's torsos are never closer than this, metres: a track that comes this
-        close to one standing still is that person twice, and the newcomer is deleted.
+        close to one standing still is that person twice, and the newcomer is deleted; and
+        a person standing still takes a moving candidate only this close (setting off).
     """
 
     accel_std_mps2: float = 1.5
@@ -178,21 +179,16 @@ class TrackState:
     def dead(self) -> bool:
         """Whether this track ends now: unlikely, lost, or tentative too long."""
         p, e = self.params, self.existence
-        if self.confirmed and e.probability < e.params.delete:
+        # the evidence of absence alone ends any track, whatever its shape; the shape too
+        # ends a confirmed one (a tentative track's shape is not known well yet)
+        if e.l_dyn <= logit(e.params.delete) or (self.confirmed and e.probability < e.params.delete):
             return True
-        # a tentative track's shape is not yet known well: it ends by time, or by evidence
-        # of absence alone
-        if not self.confirmed and (self.stamp - self.born > p.max_tentative_s or e.l_dyn <= logit(e.params.delete)):
+        if not self.confirmed and self.stamp - self.born > p.max_tentative_s:
             return True
         (a, b), (_, c) = self.position_cov
         # largest eigenvalue of the 2x2 covariance [[a, b], [b, c]]
         largest = 0.5 * (a + c) + math.sqrt(0.25 * (a - c) ** 2 + b * b)
         return math.sqrt(max(largest, 0.0)) > p.max_position_std_m
-
-    @property
-    def held_still(self) -> bool:
-        """Kept in place by static evidence (standing, paused) since its last moving update."""
-        return not self.moved or self.last_update > self.last_moving_update
 
     def furniture(self) -> bool:
         """Born standing, never moved, its place never seen empty, never confirmed: not a person."""

@@ -259,7 +259,7 @@ def test_a_pair_of_leg_like_posts_is_never_reported_and_is_remembered_as_furnitu
 def test_a_person_held_still_is_not_pulled_away_by_a_distant_moving_candidate():
     t, _ = new_track(standing=True)
     t.confirmed = True
-    assert t.held_still
+    assert t.still
     trk = PeopleTracker()
     trk._tracks = [t]
     for k in range(1, 8):  # coasting: its gate grows far beyond 1 m
