@@ -54,9 +54,10 @@ class SceneRun:
     truths: list  # the simulator's Truth per scan
 
 
-def run_scene(name: str, seed: int | None, duration: float | None, people: int | None = None) -> SceneRun:
+def run_scene(name: str, seed: int | None, duration: float | None, people: int | None = None,
+              config=None) -> SceneRun:
     source = SimulatedSource(name, seed=seed, duration=duration, people=people)
-    tracker = PeopleTracker.from_config(load_config())
+    tracker = PeopleTracker.from_config(config if config is not None else load_config())
     rows, world, stamps = [], [], []
     for record in source.scans():
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)

@@ -65,6 +65,12 @@ class DetectorParams:
         A reading counts as remembered when ``static_memory_min_scans`` of those scans saw
         it; objects within ``static_memory_keep_m`` of a tracked person are kept (a person
         turning back stands where they stood a moment before).
+    drop_carried
+        Also drop objects carried by the robot (its own mast, a handle, a bumper the laser
+        sees): at least half of their readings lie at the same place *in the sensor frame*
+        in every one of those earlier scans, while the sensor moved enough that a
+        world-fixed reading would have shifted by over twice Δd_c. Nothing walks that rigidly
+        with the laser.
     """
 
     k_closest: float = 6.0
@@ -84,6 +90,7 @@ class DetectorParams:
     static_memory_share: float = 0.3
     static_memory_min_scans: int = 1
     static_memory_keep_m: float = 1.0
+    drop_carried: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -224,6 +231,8 @@ class MovingObjectDetector:
         memory = self._lookback(scan.stamp, p.static_memory_s, need_pose=pose is not None)
         if not memory:
             return keep
+        if p.drop_carried and pose is not None:
+            keep &= ~self._carried(scan, pose, spans, pts, ranges, memory)
         test = np.arange(len(spans))
         if people is not None and len(people):
             xy = np.array([pts[a:b].mean(axis=0) for a, b in spans])
@@ -245,6 +254,24 @@ class MovingObjectDetector:
         share = np.add.reduceat(remembered, np.concatenate([[0], np.cumsum(sizes)[:-1]])) / sizes
         keep[test[share >= p.static_memory_share]] = False
         return keep
+
+    def _carried(self, scan: Scan, pose: Pose2D, spans: list[tuple[int, int]], pts: np.ndarray,
+                 ranges: np.ndarray, memory: list[_Past]) -> np.ndarray:
+        """Which objects ride with the sensor (see ``drop_carried`` in :class:`DetectorParams`)."""
+        p = self.params
+        idx = np.concatenate([np.arange(a, b) for a, b in spans])
+        q = pts[idx]
+        thr = range_threshold(ranges[idx], scan.resolution, p.k_closest, p.closest_floor_m)
+        rigid = np.ones(len(q), dtype=bool)
+        for past in memory:
+            if past.pose is None:
+                return np.zeros(len(spans), dtype=bool)
+            shift = np.hypot(*(past.pose.between(pose).transform_points(q) - q).T)
+            d, _ = past.tree.query(q, distance_upper_bound=float(thr.max()))
+            rigid &= (d <= thr) & (shift > 2.0 * thr)
+        sizes = np.array([b - a for a, b in spans])
+        share = np.add.reduceat(rigid.astype(float), np.concatenate([[0], np.cumsum(sizes)[:-1]])) / sizes
+        return share >= 0.5
 
     def _earlier(self, stamp: float) -> list[_Past]:
         """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""

@@ -66,6 +66,7 @@ class DetectorConfig:
     static_memory_share: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1.0))
     static_memory_min_scans: int = field(metadata=_spec(lo=1, hi=100))
     static_memory_keep_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
+    drop_carried: bool = field(metadata=_spec())
 
     def params(self):
         """The detector's own parameter object."""
@@ -138,6 +139,17 @@ class ExistenceConfig:
     unseen_half_life_s: float = field(metadata=_spec(lo=0.0, hi=86400.0))
     report_unseen_s: float = field(metadata=_spec(lo=0.0, hi=86400.0))
     motion_miss_lr: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1e6))
+    confidence_raw: tuple = field(metadata=_spec(lo=0.0, hi=1.0))
+    confidence_calibrated: tuple = field(metadata=_spec(lo=0.0, hi=1.0))
+
+    def __post_init__(self) -> None:
+        raw, cal = self.confidence_raw, self.confidence_calibrated
+        if len(raw) != len(cal):
+            raise InputError(f"configuration keys 'existence.confidence_raw' and 'existence.confidence_calibrated' "
+                             f"must have the same length ({len(raw)} and {len(cal)})")
+        if any(b <= a for a, b in zip(raw, raw[1:])) or any(b < a for a, b in zip(cal, cal[1:])):
+            raise InputError("configuration key 'existence.confidence_raw' must increase and "
+                             "'existence.confidence_calibrated' must not decrease")
 
     def params(self):
         from people_tracker.tracker.existence import ExistenceParams

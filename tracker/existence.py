@@ -41,6 +41,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from people_tracker.detection.free_space import OCCUPIED, SEEN_THROUGH
 
 
@@ -86,6 +88,11 @@ class ExistenceParams:
         Likelihood ratio per independent observation of a walking track (not standing
         still) that got no moving candidate while its place was in view: a walking person
         is seen moving nearly every scan, clutter that flickers now and then is not.
+    confidence_raw, confidence_calibrated : tuple of float
+        The calibration map of the reported ``confidence``: existence probabilities and the
+        share of reported tracks at them that were people, linear between (fitted by
+        ``benchmarks/fit_confidence.py`` on simulated scenes). Confirming, reporting and
+        deleting use the existence probability itself.
     report_unseen_s : float
         A confirmed track with no update for longer than this is kept (its id, its place,
         its evidence) but not reported until it is seen again, s.
@@ -112,6 +119,8 @@ class ExistenceParams:
     place_before_s: float = 2.0
     unseen_half_life_s: float = 10.0
     motion_miss_lr: float = 0.5
+    confidence_raw: tuple[float, ...] = (0.0, 1.0)
+    confidence_calibrated: tuple[float, ...] = (0.0, 1.0)
     report_unseen_s: float = 2.0
 
 
@@ -145,6 +154,13 @@ class Existence:
     @property
     def probability(self) -> float:
         return sigmoid(self.l_dyn + self.l_shape)
+
+    @property
+    def confidence(self) -> float:
+        """The existence probability through the calibration map: of the reported tracks
+        with this confidence, about this share are people."""
+        p = self.params
+        return float(np.interp(self.probability, p.confidence_raw, p.confidence_calibrated))
 
     def update(self, stamp: float, update: str | None, visibility: int, leg_probability: float | None,
                furniture_place: bool = False, walking: bool = False) -> None:

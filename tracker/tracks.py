@@ -200,4 +200,4 @@ class TrackState:
         cov = self.position_cov
         status = "tentative" if not self.confirmed else ("confirmed" if self.updated_now else "coasting")
         return Track(self.track_id, x, y, vx, vy, ((float(cov[0, 0]), float(cov[0, 1])), (float(cov[1, 0]), float(cov[1, 1]))),
-                     status, self.existence.probability, self.stamp - self.born, target)
+                     status, self.existence.confidence, self.stamp - self.born, target)

@@ -1,0 +1,64 @@
+"""Fit the calibration map of the reported ``confidence`` (``existence.confidence_raw`` and
+``existence.confidence_calibrated`` in ``configs/default.yaml``).
+
+The tracker runs with the identity map over simulated scenes whose seeds are *not* the
+ones ``benchmarks/track_evidence.py`` reports on (the waiting room with seeds 1 and 2, the
+crowd with seed 1, the other scenes with their seed + 100); every reported track-scan is
+an example: its existence probability, and whether it lay within 0.5 m of a person. An
+isotonic regression (scikit-learn, the ``[train]`` extra) maps one to the other; its
+knots, thinned to at most 12, are printed as the two YAML lines to paste.
+
+Usage::
+
+    python benchmarks/fit_confidence.py
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from track_evidence import nearest_person, run_scene, NEAR_M
+from people_tracker.models.scenario import load_scenario
+from people_tracker.tracker.config import config_from_dict
+
+TRAIN = [("waiting_room", 1), ("waiting_room", 2), ("crowd", 1), ("crossing", None), ("stop_and_go", None),
+         ("occlusion", None), ("following", None), ("corridor", None)]
+
+
+def examples() -> tuple[np.ndarray, np.ndarray]:
+    identity = config_from_dict({"existence": {"confidence_raw": [0.0, 1.0], "confidence_calibrated": [0.0, 1.0]}})
+    raw, near = [], []
+    for name, seed in TRAIN:
+        if seed is None:
+            seed = int(load_scenario(name).get("seed", 0)) + 100
+        run = run_scene(name, seed, None, config=identity)
+        dist, _ = nearest_person(run)
+        raw.append(run.rows[:, 4])
+        near.append(dist <= NEAR_M)
+        print(f"{name} seed {seed}: {len(run.rows)} reported track-scans, {np.mean(near[-1]):.3f} near a person",
+              file=sys.stderr, flush=True)
+    return np.concatenate(raw), np.concatenate(near)
+
+
+def fit(raw: np.ndarray, near: np.ndarray, knots: int = 12) -> tuple[list[float], list[float]]:
+    from sklearn.isotonic import IsotonicRegression
+    iso = IsotonicRegression(y_min=0.0, y_max=1.0, out_of_bounds="clip").fit(raw, near.astype(float))
+    x = np.quantile(raw, np.linspace(0.0, 1.0, knots))
+    x = np.unique(np.concatenate([[0.0], x, [1.0]]))
+    return [round(float(v), 3) for v in x], [round(float(v), 3) for v in np.maximum.accumulate(iso.predict(x))]
+
+
+def main() -> int:
+    raw, near = examples()
+    xs, ys = fit(raw, near)
+    # equal rounded x values would make the map ill-defined
+    keep = [0] + [i for i in range(1, len(xs)) if xs[i] > xs[i - 1]]
+    print(f"  confidence_raw: [{', '.join(f'{xs[i]:g}' for i in keep)}]")
+    print(f"  confidence_calibrated: [{', '.join(f'{ys[i]:g}' for i in keep)}]")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
