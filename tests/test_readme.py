@@ -23,7 +23,7 @@ def _commands() -> list[tuple[str, str, str]]:
             for line in block.splitlines():
                 for call in re.findall(r"people-tracker((?:\s+[^\s&|;`]+)*)", line):
                     words = call.split()
-                    if words and not words[0].startswith("-") and re.fullmatch(r"[a-z][a-z-]*", words[0]):
+                    if words and not words[0].startswith("-") and re.fullmatch(r"[a-z][a-z0-9-]*", words[0]):
                         out.append((doc.name, words[0], " ".join(w for w in words[1:] if w.startswith("--"))))
     return out
 
@@ -32,7 +32,7 @@ COMMANDS = _commands()
 
 
 def test_the_readme_shows_the_commands():
-    assert {c for _, c, _ in COMMANDS} >= {"run", "evaluate", "simulate", "bench", "train-legs"}
+    assert {c for _, c, _ in COMMANDS} >= {"run", "evaluate", "simulate", "bench", "train-legs", "ros2", "replay"}
 
 
 @pytest.fixture(scope="module")

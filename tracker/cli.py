@@ -156,6 +156,28 @@ def _build_parser() -> argparse.ArgumentParser:
     tl.add_argument("--trees", type=int, default=200, help="boosting rounds (%(default)s)")
     tl.add_argument("--simulated", type=int, default=600, metavar="N",
                     help="also N scans of simulated rooms with people and furniture, every leg known (%(default)s; 0: none)")
+    ros = sub.add_parser("ros2", help="run as a live ROS 2 node ([ros2] extra): scans in, people out", parents=[common],
+                         epilog="Publishes people (geometry_msgs/PoseArray), people_markers (visualization_msgs/"
+                                "MarkerArray), people_target (geometry_msgs/PoseStamped) and, with --legs, legs "
+                                "(PoseArray), all in the fixed frame. Every option is also a ROS parameter: "
+                                "--ros-args -p scan_topic:=/front_scan. Ctrl-C: exit 0 with latency figures.")
+    ros.add_argument("--scan-topic", default="/scan", help="sensor_msgs/LaserScan topic (%(default)s)")
+    odom = ros.add_mutually_exclusive_group()
+    odom.add_argument("--odom-topic", default="/odom", help="nav_msgs/Odometry topic (%(default)s)")
+    odom.add_argument("--no-odom", action="store_true", help="no odometry: scan matching alone finds the motion")
+    ros.add_argument("--mount", type=float, nargs=3, default=[0.0, 0.0, 0.0], metavar=("X", "Y", "YAW_DEG"),
+                     help="the laser in the odometry's base frame: metres, metres, degrees (0 0 0)")
+    ros.add_argument("--fixed-frame", default="odom", help="frame of the published positions (%(default)s)")
+    ros.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
+    ros.add_argument("--follow", metavar="auto|ID", help="follow a person: the closest ahead (auto) or a track id")
+    ros.add_argument("--legs", action="store_true", help="also publish the likely leg candidates on legs")
+    rp = sub.add_parser("replay", help="publish a recording's scans and odometry on ROS 2 ([ros2] extra)",
+                        parents=[common])
+    rp.add_argument("input", metavar="INPUT", help="a ROS 1 .bag, a ROS 2 bag folder, or an .mcap file")
+    rp.add_argument("--topic", help="LaserScan topic (default: the only one)")
+    rp.add_argument("--rate", type=float, default=1.0, help="times the recorded pace (%(default)s)")
+    rp.add_argument("--wait", type=float, default=5.0, metavar="S",
+                    help="wait up to S seconds for a subscriber before starting (%(default)s)")
     bench = sub.add_parser("bench", help="accuracy and speed on every recording and simulated scene", parents=[common])
     bench.add_argument("--data", metavar="DIR", help="folder of recordings (default: $PEOPLE_TRACKER_DATA, "
                        "else ../shared/data)")
@@ -464,9 +486,37 @@ def _cmd_train_legs(args) -> int:
     return 0
 
 
+def _cmd_ros2(args) -> int:
+    import math as _math
+
+    from people_tracker.tracker.config import load_config
+    from people_tracker.tracker.ros2_node import NodeOptions, run_node
+
+    config = load_config(args.config)
+    if args.follow is not None and args.follow != "auto" and not args.follow.isdigit():
+        raise InputError(f"--follow takes auto or a track id, got '{args.follow}'")
+    x, y, yaw_deg = args.mount
+    if not all(_math.isfinite(v) for v in args.mount):
+        raise InputError("--mount takes three finite numbers: X Y YAW_DEG")
+    options = NodeOptions(args.scan_topic, "" if args.no_odom else args.odom_topic, (x, y, _math.radians(yaw_deg)),
+                          args.fixed_frame, args.follow or "", args.legs)
+    return run_node(options, config, args.ros_args)
+
+
+def _cmd_replay(args) -> int:
+    from people_tracker.tracker.config import load_config
+    from people_tracker.tracker.ros2_node import replay
+
+    return replay(args.input, args.topic, args.rate, load_config(), args.wait, args.ros_args)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``people-tracker`` console script; returns the exit status."""
     argv = sys.argv[1:] if argv is None else argv
+    ros_args = None
+    if "--ros-args" in argv:  # ROS's own arguments go to rclpy, untouched
+        k = argv.index("--ros-args")
+        argv, ros_args = argv[:k], argv[k:]
     try:
         args = _build_parser().parse_args(argv)
     except _CliError as exc:
@@ -474,8 +524,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     handler = _setup_logging(args.quiet, args.verbose and not args.quiet)
     args.argv = list(argv)
+    args.ros_args = ["--ros-args", *ros_args[1:]] if ros_args else None
     commands = {"run": _cmd_run, "evaluate": _cmd_evaluate, "simulate": _cmd_simulate, "bench": _cmd_bench,
-                "train-legs": _cmd_train_legs}
+                "train-legs": _cmd_train_legs, "ros2": _cmd_ros2, "replay": _cmd_replay}
     try:
         return commands[args.command](args)
     except InputError as exc:
