@@ -299,9 +299,9 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
         thread.join(timeout=0.5)
         node.destroy_node()
         rclpy.try_shutdown()
-    print(f"people-tracker ros2: {state['processed']} scans tracked, {state['dropped']} dropped; latency "
-          f"(scan received -> people published) p50 {_percentile_ms(latencies, 50):.2f} ms, "
-          f"p99 {_percentile_ms(latencies, 99):.2f} ms", flush=True)
+    timing = (f"latency (scan received -> people published) p50 {_percentile_ms(latencies, 50):.2f} ms, "
+              f"p99 {_percentile_ms(latencies, 99):.2f} ms" if latencies else "no scan arrived")
+    print(f"people-tracker ros2: {state['processed']} scans tracked, {state['dropped']} dropped; {timing}", flush=True)
     return 0
 
 
