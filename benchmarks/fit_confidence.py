@@ -39,7 +39,7 @@ def examples() -> tuple[np.ndarray, np.ndarray]:
         raw.append(run.rows[:, 4])
         near.append(dist <= NEAR_M)
         print(f"{name} seed {seed}: {len(run.rows)} reported track-scans, {np.mean(near[-1]):.3f} near a person",
-              file=sys.stderr, flush=True)
+              flush=True)
     return np.concatenate(raw), np.concatenate(near)
 
 
