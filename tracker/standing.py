@@ -3,13 +3,14 @@
 Someone who stands still never moves, so motion detection (the paper's method) never
 reports them; on the annotated hallway recording most of the people are standing. Their
 legs still look like legs: two segments the leg model (:mod:`people_tracker.models.leg_model`) finds
-more likely legs than not, a stance apart. Such a pair starts a track
+likely enough, a stance apart. Such a pair starts a tentative track
 only when it comes back at the same place in the world in most of the last few scans (a
 one-off coincidence of two unrelated segments does not), never near an existing track,
-and never where a standing track was already ended as furniture: a standing track that
-has not moved after ``max_static_s`` (see :class:`~people_tracker.tracker.tracks.TrackParams`) is
-deleted and its place remembered, so a pair of table legs costs one short track, not one
-every few seconds.
+and never where a standing track was already ended as furniture. The track is confirmed
+by its evidence (:mod:`people_tracker.tracker.existence`): its place was seen empty before,
+or it moves. One that never moved, on a place never seen empty, and was never confirmed
+ends as furniture and its place is remembered, so a pair of table legs costs one short
+tentative track, not one every few seconds.
 """
 
 from __future__ import annotations

@@ -5,8 +5,8 @@ detector does not report them. For a confirmed track that got no moving candidat
 scan's own readings near its prediction are looked at: the segments (all readings, any
 set) that come within ``radius`` of the prediction are united, and if together they are
 person-sized they support the track at their centre — the paper's Join with A_C, lifted
-from one scan to a track. Static support never starts a track, and a track kept only by
-it is deleted after ``max_static_s`` (see :class:`~people_tracker.tracker.tracks.TrackParams`).
+from one scan to a track. Static support never starts a track; what it is worth as
+evidence that the person is still there is :mod:`people_tracker.tracker.existence`'s to say.
 """
 
 from __future__ import annotations
