@@ -44,6 +44,9 @@ LISTENER = textwrap.dedent('''
     n.create_subscription(MarkerArray, "people_markers", on_markers, 1000)
     n.create_subscription(PoseArray, "people", on_people, 1000)
     print("listening", flush=True)
+    while n.count_publishers("people_markers") == 0:  # the node found: nothing it says is missed
+        rclpy.spin_once(n, timeout_sec=0.05)
+    print("matched", flush=True)
     end = time.time() + float(sys.argv[2])
     while time.time() < end:
         rclpy.spin_once(n, timeout_sec=0.05)
@@ -82,6 +85,8 @@ def test_the_node_publishes_what_the_offline_run_writes(tmp_path, moving_bag):
                                 stdout=subprocess.PIPE, text=True)
     assert listener.stdout.readline().strip() == "listening"
     node = _start_node(env, "--mount", "0.850326", "0.235214", "42.1014")
+    assert listener.stdout.readline().strip() == "matched"
+    time.sleep(1.0)  # and the node's side of the match settled
     replay = subprocess.run(cli_command() + ["replay", str(moving_bag), "--rate", "4"], env=env, capture_output=True,
                             text=True, timeout=120)
     assert replay.returncode == 0, replay.stderr
