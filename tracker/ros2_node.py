@@ -79,6 +79,7 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
     from visualization_msgs.msg import Marker, MarkerArray
 
     from people_tracker.detection.deskew import sweep_duration
+    from people_tracker.tracker.io.bag import stamp_seconds
     from people_tracker.tracker.io.odometry import PoseSeries, pose_from_msg
     from people_tracker.tracker.io.recording import scan_from_msg
     from people_tracker.tracker.people_tracker import PeopleTracker
@@ -137,7 +138,7 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
             lock.notify()
 
     def on_odom(msg) -> None:
-        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        stamp = stamp_seconds(msg.header.stamp)
         pose = pose_from_msg(msg.pose.pose.position, msg.pose.pose.orientation)[0]
         with lock:
             series.add(stamp, pose)  # a sample that goes back in time is dropped, as offline
@@ -250,7 +251,7 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
         if len(series) == 0:
             return True
         try:
-            stamp = item.msg.header.stamp.sec + item.msg.header.stamp.nanosec * 1e-9
+            stamp = stamp_seconds(item.msg.header.stamp)
             sweep = max(float(item.msg.time_increment), 0.0) * max(len(item.msg.ranges) - 1, 0)
         except Exception:
             return True
