@@ -35,7 +35,6 @@ from people_tracker.models.pose import pairwise_distances
 from people_tracker.tracker.config import load_config
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.bench import scene_ground_truth
-from people_tracker.tracker.io.ground_truth import GroundTruth
 from people_tracker.tracker.io.simulated import SimulatedSource
 from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 
@@ -69,11 +68,6 @@ def run_scene(name: str, seed: int | None, duration: float | None, people: int |
                     np.array(world, dtype=float).reshape(-1, 2), source.truths)
 
 
-def ground_truth(run: SceneRun) -> tuple[GroundTruth, GroundTruth]:
-    """The visible people and the hidden ones (there, out of sight)."""
-    return scene_ground_truth(run.truths)
-
-
 def nearest_person(run: SceneRun) -> tuple[np.ndarray, np.ndarray]:
     """For each reported row: the distance to the nearest person in the scene (m) and their id."""
     dist = np.full(len(run.rows), np.inf)
@@ -93,7 +87,7 @@ def nearest_person(run: SceneRun) -> tuple[np.ndarray, np.ndarray]:
 
 def scene_figures(run: SceneRun) -> dict:
     r = run.rows
-    gt, hidden = ground_truth(run)
+    gt, hidden = scene_ground_truth(run.truths)  # the visible people and the hidden ones
     rows = TrackRows(r[:, 0].astype(np.int64), r[:, 1].astype(np.int64), r[:, 2], r[:, 3])
     result = evaluate(gt, rows, hidden=hidden)
     strict = evaluate(gt, rows)

@@ -173,6 +173,13 @@ def combine(pairs: list[np.ndarray]) -> np.ndarray:
     return out
 
 
+def _share_per_span(flags: np.ndarray, spans: list[tuple[int, int]]) -> np.ndarray:
+    """For readings laid out span after span (``flags``: one bool per reading of the spans,
+    in order), the share of each span's readings that are flagged."""
+    sizes = np.array([b - a for a, b in spans])
+    return np.add.reduceat(flags.astype(float), np.concatenate([[0], np.cumsum(sizes)[:-1]])) / sizes
+
+
 class MovingObjectDetector:
     """Keeps the scan history and finds the moving objects of each new scan.
 
@@ -249,9 +256,7 @@ class MovingObjectDetector:
             rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
             d, _ = past.tree.query(rel.transform_points(q), distance_upper_bound=float(thr.max()))
             seen += d <= thr
-        remembered = (seen >= p.static_memory_min_scans).astype(float)
-        sizes = np.array([spans[k][1] - spans[k][0] for k in test])
-        share = np.add.reduceat(remembered, np.concatenate([[0], np.cumsum(sizes)[:-1]])) / sizes
+        share = _share_per_span(seen >= p.static_memory_min_scans, [spans[k] for k in test])
         keep[test[share >= p.static_memory_share]] = False
         return keep
 
@@ -269,9 +274,7 @@ class MovingObjectDetector:
             shift = np.hypot(*(past.pose.between(pose).transform_points(q) - q).T)
             d, _ = past.tree.query(q, distance_upper_bound=float(thr.max()))
             rigid &= (d <= thr) & (shift > 2.0 * thr)
-        sizes = np.array([b - a for a, b in spans])
-        share = np.add.reduceat(rigid.astype(float), np.concatenate([[0], np.cumsum(sizes)[:-1]])) / sizes
-        return share >= 0.5
+        return _share_per_span(rigid, spans) >= 0.5
 
     def _earlier(self, stamp: float) -> list[_Past]:
         """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""

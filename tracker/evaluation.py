@@ -116,9 +116,7 @@ def without_hidden(gt: GroundTruth, hidden: GroundTruth, tracks: TrackRows, thre
         for r, c in zip(rows, cols):
             if r >= len(g) and d[r, c] <= threshold:
                 keep[t[c]] = False
-    out = replace(tracks, **{f.name: getattr(tracks, f.name)[keep] for f in fields(tracks)
-                             if isinstance(getattr(tracks, f.name), np.ndarray)})
-    return out, int((~keep).sum())
+    return _rows_where(tracks, keep), int((~keep).sum())
 
 
 def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", threshold: float = 0.75,
@@ -210,7 +208,11 @@ def _in_window(rows, window_deg: tuple[float, float]):
     """The rows (GroundTruth or TrackRows) whose sensor-frame bearing is inside the window."""
     lo, hi = np.radians(window_deg[0]), np.radians(window_deg[1])
     bearing = np.arctan2(rows.y, rows.x)
-    keep = (bearing >= lo) & (bearing <= hi)
+    return _rows_where(rows, (bearing >= lo) & (bearing <= hi))
+
+
+def _rows_where(rows, keep: np.ndarray):
+    """The rows (GroundTruth or TrackRows) where ``keep`` (bool, one per row) is true."""
     return replace(rows, **{f.name: getattr(rows, f.name)[keep] for f in fields(rows)
                             if isinstance(getattr(rows, f.name), np.ndarray) and getattr(rows, f.name).shape == keep.shape})
 

@@ -236,14 +236,11 @@ class PeopleTracker:
         passer-by). They get their id back when it is free, and their evidence."""
         if not self._stood:
             return
-        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
-        lost = [e for e in self._stood if not len(known) or
-                np.hypot(*(known - e[0]).T).min() >= self.assoc.spawn_exclusion_m]
+        clear = self._clear_of_tracks(np.array([e[0] for e in self._stood]))
+        lost = [e for e, c in zip(self._stood, clear) if c]
         if not lost:
             return
-        d = self.detector.params
-        found = static_support(np.array([e[0] for e in lost]), world, scan, d.k_segment, d.segment_floor_m,
-                               self.assoc.support_radius_m, self.pairing.max_person_size_m, self.assoc.support_min_points)
+        found = self._static_support(np.array([e[0] for e in lost]), scan, world)
         used = {t.track_id for t in self._tracks}
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
         for e, z in zip(lost, found):
@@ -330,23 +327,31 @@ class PeopleTracker:
             self._tracks[idle[a]].forget_velocity()
         return [(idle[a], free[b]) for a, b in pairs]
 
+    def _static_support(self, places: np.ndarray, scan: Scan, world: Pose2D) -> list[np.ndarray | None]:
+        """A person-sized group of this scan's readings near each place (world frame), or None."""
+        d = self.detector.params
+        return static_support(places, world, scan, d.k_segment, d.segment_floor_m, self.assoc.support_radius_m,
+                              self.pairing.max_person_size_m, self.assoc.support_min_points)
+
+    def _clear_of_tracks(self, xy: np.ndarray) -> np.ndarray:
+        """Whether each place (world frame) is at least ``spawn_exclusion_m`` from every track."""
+        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
+        if not len(known) or not len(xy):
+            return np.ones(len(xy), dtype=bool)
+        return pairwise_distances(xy, known).min(axis=1) >= self.assoc.spawn_exclusion_m
+
     def _support(self, scan: Scan, world: Pose2D, matched: set[int]) -> None:
         idle = [i for i, t in enumerate(self._tracks) if t.confirmed and i not in matched]
         if not idle:
             return
-        d = self.detector.params
-
-        def support(places: np.ndarray) -> list[np.ndarray | None]:
-            return static_support(places, world, scan, d.k_segment, d.segment_floor_m, self.assoc.support_radius_m,
-                                  self.pairing.max_person_size_m, self.assoc.support_min_points)
-
-        found = support(np.array([self._tracks[i].position for i in idle]))
+        found = self._static_support(np.array([self._tracks[i].position for i in idle]), scan, world)
         # someone who stops stands where their legs were last seen moving, while the
         # prediction walks on: look there too
         again = [k for k, z in enumerate(found) if z is None and
                  np.hypot(*(self._tracks[idle[k]].position - self._tracks[idle[k]].moving_position)) > 0.1]
         if again:
-            for k, z in zip(again, support(np.array([self._tracks[idle[k]].moving_position for k in again]))):
+            places = np.array([self._tracks[idle[k]].moving_position for k in again])
+            for k, z in zip(again, self._static_support(places, scan, world)):
                 found[k] = z
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
         for i, z in zip(idle, found):
@@ -386,15 +391,7 @@ class PeopleTracker:
             return
         xy = np.array([(c.x, c.y) for c in standing]).reshape(-1, 2)
         persistent = self.standing.persistent(xy)
-        chosen = [standing[k] for k in np.flatnonzero(persistent)]
-        xy = np.array([(c.x, c.y) for c in chosen]).reshape(-1, 2)
-        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
-        if len(known) and len(xy):  # those the spawn rule would turn away need no history
-            keep = pairwise_distances(xy, known).min(axis=1) >= self.assoc.spawn_exclusion_m
-            chosen, xy = [c for c, k in zip(chosen, keep) if k], xy[keep]
-        places = [self._place_history(p, stamp) for p in xy]
-        arrived = self._seen_empty(xy, stamp) | np.array([p == PlaceMemory.EMPTY for p in places], dtype=bool)
-        self._spawn(chosen, stamp, standing=True, arrived=arrived, places=places)
+        self._spawn([standing[k] for k in np.flatnonzero(persistent)], stamp, standing=True)
 
     def _seen_empty(self, xy: np.ndarray, stamp: float) -> np.ndarray:
         """Whether a scan about ½, 1 or 1½ free-space lookbacks ago saw past each place."""
@@ -407,21 +404,25 @@ class PeopleTracker:
                                  self.detector.params.no_return_free_m)
         return seen
 
-    def _spawn(self, candidates: list[PersonCandidate], stamp: float, standing: bool = False,
-               arrived: np.ndarray | None = None, places: list[str] | None = None) -> None:
-        """A new track for each candidate not within the spawn exclusion of any track."""
-        known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
+    def _spawn(self, candidates: list[PersonCandidate], stamp: float, standing: bool = False) -> None:
+        """A new track for each candidate not within the spawn exclusion of any track.
+
+        A moving candidate's place was seen empty just before (``_initiate`` only offers
+        those); a standing pair's place is looked up: seen empty lately or in the place
+        memory, someone arrived there."""
         best = self._best_leg(np.array([(c.x, c.y) for c in candidates]).reshape(-1, 2))
-        base = self.leg_model.base_rate
         for k, c in enumerate(candidates):
-            if len(known) and np.hypot(*(known - (c.x, c.y)).T).min() < self.assoc.spawn_exclusion_m:
+            xy = np.array([c.x, c.y])
+            if not self._clear_of_tracks(xy[None])[0]:  # also clear of the tracks just started
                 continue
-            ex = Existence(self.existence, stamp, standing, bool(arrived[k]) if arrived is not None else True,
-                           None if best[k] != best[k] else float(best[k]), base)
+            place, arrived = None, True
+            if standing:
+                place = self._place_history(xy, stamp)
+                arrived = place == PlaceMemory.EMPTY or bool(self._seen_empty(xy[None], stamp)[0])
+            ex = Existence(self.existence, stamp, standing, arrived, None if best[k] != best[k] else float(best[k]),
+                           self.leg_model.base_rate)
             self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params, ex, standing))
-            if places is not None:
-                self._tracks[-1].place = places[k]
-            known = np.vstack([known, [c.x, c.y]])
+            self._tracks[-1].place = place
             self._next_id += 1
 
     def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float) -> None:

@@ -60,10 +60,18 @@ def _percentile_ms(values: list[float], q: float) -> float:
 
 
 class _Pending:
-    __slots__ = ("msg", "received", "index")
+    __slots__ = ("msg", "received", "index", "_decoded")
 
     def __init__(self, msg, received: float, index: int) -> None:
         self.msg, self.received, self.index = msg, received, index
+        self._decoded = None
+
+    def decoded(self):
+        """The message's scan, or None and why not (decoded once, in the worker)."""
+        if self._decoded is None:
+            from people_tracker.tracker.io.recording import decode_scan
+            self._decoded = decode_scan(lambda: self.msg)
+        return self._decoded
 
 
 def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) -> int:
@@ -81,7 +89,6 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
     from people_tracker.detection.deskew import sweep_duration
     from people_tracker.tracker.io.bag import stamp_seconds
     from people_tracker.tracker.io.odometry import PoseSeries, pose_from_msg
-    from people_tracker.tracker.io.recording import scan_from_msg
     from people_tracker.tracker.people_tracker import PeopleTracker
     from people_tracker.tracker.scan_checks import ScanChecker
 
@@ -201,11 +208,7 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
 
     def process(item: _Pending) -> None:
         msg = item.msg
-        problem = scan = None
-        try:
-            scan = scan_from_msg(msg)
-        except Exception as exc:
-            problem = f"cannot be decoded ({' '.join(str(exc).split())[:120]})"
+        scan, problem = item.decoded()
         pose = pose_last = None
         if scan is not None:
             with lock:
@@ -248,14 +251,10 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
 
     def ready(item: _Pending) -> bool:
         """Odometry covers the sweep, or none has come at all, or it waited long enough."""
-        if len(series) == 0:
+        scan = item.decoded()[0]
+        if len(series) == 0 or scan is None:
             return True
-        try:
-            stamp = stamp_seconds(item.msg.header.stamp)
-            sweep = max(float(item.msg.time_increment), 0.0) * max(len(item.msg.ranges) - 1, 0)
-        except Exception:
-            return True
-        return series.newest >= stamp + sweep or time.perf_counter() - item.received > odo.max_wait_s
+        return series.newest >= scan.stamp + sweep_duration(scan) or time.perf_counter() - item.received > odo.max_wait_s
 
     def worker() -> None:
         while True:

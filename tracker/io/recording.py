@@ -70,6 +70,15 @@ def scan_from_msg(msg) -> Scan:
     )
 
 
+def decode_scan(get_msg) -> tuple[Scan | None, str | None]:
+    """The :class:`Scan` of the message ``get_msg()`` returns, or None and why not (the
+    warning a bad scan gets, here and in the ROS 2 node)."""
+    try:
+        return scan_from_msg(get_msg()), None
+    except Exception as exc:
+        return None, f"cannot be decoded ({' '.join(str(exc).split())[:120]})"
+
+
 class Recording:
     """A recording opened for reading its laser scans with poses.
 
@@ -146,11 +155,8 @@ class Recording:
         self.close()
 
     def _decode(self, index: int, bag_time: int, raw) -> ScanRecord:
-        try:
-            scan = scan_from_msg(self._reader.deserialize(raw, LASER_SCAN))
-        except Exception as exc:
-            return ScanRecord(index, bag_time, None, None, f"cannot be decoded ({' '.join(str(exc).split())[:120]})")
-        return ScanRecord(index, bag_time, scan, None)
+        scan, problem = decode_scan(lambda: self._reader.deserialize(raw, LASER_SCAN))
+        return ScanRecord(index, bag_time, scan, None, problem)
 
     def scans(self) -> Iterator[ScanRecord]:
         """Every message of the scan topic in recorded order, each with its pose."""
