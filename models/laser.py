@@ -32,6 +32,9 @@ class LaserModel:
         Probability that a reading is lost, reported as ``dropout_value``.
     dropout_value : float
         ``nan`` or ``0.0``, as different drivers report a lost reading.
+    spurious : float
+        Probability that a reading is a spurious short one (sunlight, dust): a range drawn
+        uniformly between ``range_min`` and what the beam would have hit.
     clockwise : bool
         Beams counted clockwise (negative ``angle_increment``).
     frame_id : str
@@ -49,6 +52,7 @@ class LaserModel:
     noise_std: float = 0.01
     dropout: float = 0.0
     dropout_value: float = float("nan")
+    spurious: float = 0.0
     clockwise: bool = False
     frame_id: str = "laser"
     sweep_fraction: float = 0.75
@@ -106,7 +110,8 @@ class LaserModel:
         scan : Scan
         hit : ndarray of int, shape (n,)
             What each beam hit (index into segments then circles; -1 nothing; a dropped
-            or out-of-range reading still reports what the beam would have hit).
+            or out-of-range reading still reports what the beam would have hit; a spurious
+            one reports -1).
         """
         n = self.n_beams
         angles = self.beam_angles()
@@ -126,6 +131,11 @@ class LaserModel:
         if rng is not None:
             finite = np.isfinite(ranges)
             ranges[finite] += rng.normal(0.0, self.noise_std, int(finite.sum())) if self.noise_std > 0 else 0.0
+            if self.spurious > 0:
+                fake = rng.random(n) < self.spurious
+                far = np.minimum(np.nan_to_num(ranges[fake], posinf=self.range_max), self.range_max)
+                ranges[fake] = rng.uniform(self.range_min, np.maximum(far, self.range_min))
+                hit = np.where(fake, -1, hit)
             if self.dropout > 0:
                 ranges[rng.random(n) < self.dropout] = self.dropout_value
         ranges[np.isfinite(ranges) & ((ranges >= self.range_max) | (ranges <= self.range_min))] = np.inf

@@ -112,18 +112,70 @@ class FollowDriver:
     ``target(t)`` returns the target's position or None when it is not known; the robot
     then stops. The simulator's scenarios give it the true position; the following demo
     gives it the tracker's estimate.
+
+    Parameters
+    ----------
+    distance, max_speed, max_turn : float
+        Metres kept to the target (along the way driven), m/s, rad/s.
+    trail : bool
+        Drive along the target's own path (breadcrumbs ``lookahead_m`` ahead) instead of
+        straight at them, as a robot does that must not cut corners round a building.
+    hold : (points, radius_m, seconds), optional
+        Stop for ``seconds`` when the target comes within ``radius_m`` of one of ``points``
+        (k, 2) — a safety stop — once per pass (it re-arms when they are 3 radii away).
+    beside : (windows, offset_m), optional
+        In the time windows [(t0, t1), …] (s) drive level with the target, ``offset_m`` to
+        their right, instead of behind them.
     """
 
     def __init__(self, target: Callable[[float], "np.ndarray | None"], distance: float = 1.0,
-                 max_speed: float = 1.2, max_turn: float = 1.5) -> None:
+                 max_speed: float = 1.2, max_turn: float = 1.5, trail: bool = False, hold=None, beside=None,
+                 lookahead_m: float = 0.6) -> None:
         self._target, self._dist, self._vmax, self._wmax = target, distance, max_speed, max_turn
+        self._trail_on, self._look = trail, lookahead_m
+        self._trail: list[np.ndarray] = []
+        self._hold = hold
+        self._armed = np.ones(0 if hold is None else len(hold[0]), dtype=bool)
+        self._hold_until = -math.inf
+        self._beside = beside
+        self._heading = 0.0
+
+    def _steer(self, pose: Pose2D, aim: np.ndarray, gap: float, feed: float = 0.0) -> Command:
+        err = float(wrap_angle(math.atan2(aim[1] - pose.y, aim[0] - pose.x) - pose.yaw))
+        v = float(np.clip(feed + 0.8 * gap, 0.0, self._vmax)) * max(0.0, math.cos(err))
+        return Command(v, float(np.clip(2.0 * err, -self._wmax, self._wmax)))
 
     def __call__(self, t: float, pose: Pose2D) -> Command:
         goal = self._target(t)
         if goal is None:
             return Command()
-        dx, dy = goal[0] - pose.x, goal[1] - pose.y
-        err = float(wrap_angle(math.atan2(dy, dx) - pose.yaw))
-        gap = math.hypot(dx, dy) - self._dist
-        v = float(np.clip(0.8 * gap, 0.0, self._vmax)) * max(0.0, math.cos(err))
-        return Command(v, float(np.clip(2.0 * err, -self._wmax, self._wmax)))
+        goal = np.asarray(goal, dtype=float)
+        before = self._target(t - 0.3)
+        speed = 0.0
+        if before is not None and np.hypot(*(goal - before)) > 0.03:
+            self._heading = math.atan2(*(goal - before)[::-1])
+            speed = float(np.hypot(*(goal - before))) / 0.3
+        if self._trail_on and (not self._trail or np.hypot(*(goal - self._trail[-1])) >= 0.1):
+            self._trail.append(goal)
+        here = np.array([pose.x, pose.y])
+        if self._hold is not None:
+            points, radius, seconds = self._hold
+            d = np.hypot(*(points - goal).T)
+            trigger = self._armed & (d <= radius)
+            if trigger.any():
+                self._hold_until = t + seconds
+            self._armed = (self._armed & ~trigger) | (d > 3.0 * radius)
+        if t < self._hold_until:
+            return Command()
+        if self._beside is not None and any(t0 <= t < t1 for t0, t1 in self._beside[0]):
+            u = np.array([math.cos(self._heading), math.sin(self._heading)])
+            spot = goal + self._beside[1] * np.array([u[1], -u[0]])  # to their right
+            self._trail = [goal] if self._trail_on else []
+            return self._steer(pose, spot + u, float(np.dot(spot - here, u)), speed)
+        if not self._trail_on:
+            return self._steer(pose, goal, float(np.hypot(*(goal - here))) - self._dist)
+        while len(self._trail) > 1 and np.hypot(*(self._trail[0] - here)) < self._look:
+            self._trail.pop(0)
+        path = np.vstack([here, *self._trail])
+        along = float(np.hypot(*np.diff(path, axis=0).T).sum())
+        return self._steer(pose, self._trail[0], along - self._dist)

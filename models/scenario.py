@@ -7,13 +7,18 @@ file, radians inside)::
     duration_s: 20            # s
     seed: 1                   # the same seed gives the same scans, to the byte
     laser: {fov_deg, resolution_deg, rate_hz, range_min, range_max, noise_std,
-            dropout, dropout_value (nan|zero), clockwise, frame_id, sweep_fraction}
+            dropout, dropout_value (nan|zero), spurious, clockwise, frame_id, sweep_fraction}
+    lasers: {name: {laser keys}, ...}   # other lasers the scene can run with (--laser NAME)
     world: {room: [x0, y0, x1, y1], walls: [[x0, y0, x1, y1]], boxes: [...], pillars: [[x, y, r]]}
     robot: {start: [x, y, yaw_deg], mount: [x, y, yaw_deg],
             drive: [[duration_s, v_mps, omega_degps], ...] | waypoints: [[x, y]], speed: m/s,
-            odometry_noise: {trans: fraction, rot: rad per rad}}
+            odometry_noise: {trans: fraction, rot: rad per rad}, odometry: bool (default true),
+            follow: {person, distance, max_speed, max_turn_degps, trail: bool,
+                     hold: {at: [[x, y], ...], radius_m, seconds}, beside: {windows: [[t0, t1]], offset_m}}}
     people: [{id, path: [[x, y], ...], speed: m/s or list, start_s, pauses: {waypoint: s},
-              exit: bool, round_radius: m (a round object instead of legs)}]
+              exit: bool, round_radius: m (a round object instead of legs), laps: n}]
+    passers: {person, per_minute, speed: [lo, hi], heading: across|oncoming, offset_m: [lo, hi], half_width_m,
+              same_build: bool, start_s}   # or a list of such groups
     crowd: {count, area: [x0, y0, x1, y1], speed: [lo, hi], waypoints: n, pause_s: [lo, hi]}
     visitors: {count, door: [x, y], area: [x0, y0, x1, y1], range_m: [lo, hi], stand_s: [lo, hi],
                arrive_every_s: [lo, hi], speed: [lo, hi], face_to_face: pairs, distance_m: [lo, hi]}
@@ -24,6 +29,14 @@ file, radians inside)::
 stand ``distance_m`` apart facing each other. ``furniture`` is ``count`` pairs of round legs
 (tables, chairs) in the same kind of place, there from the first scan. Both are drawn from
 the seed.
+
+``passers`` meet ``person`` (default: the followed one, else the first listed) ``per_minute`` times a minute on
+average and leave: ``across`` ones cross their heading ``offset_m`` ahead of them (negative:
+behind, between them and a robot that follows), from ``half_width_m`` on one side to as far on
+the other; ``oncoming`` ones walk the other way and pass ``offset_m`` beside them (either side); ``same_build`` gives them the person's leg radius and spacing. A person's
+``laps`` repeats their path (and its pauses) that many times. ``robot.follow`` drives after a
+person with their true position (see :class:`~people_tracker.models.robot.FollowDriver`);
+``odometry: false`` leaves odometry out of the recording.
 
 Every key is checked: an unknown one is an error that names it.
 """
@@ -51,15 +64,19 @@ class ScenarioError(ValueError):
 
 
 _KEYS = {
-    "": {"description", "duration_s", "seed", "laser", "world", "robot", "people", "crowd", "visitors",
-         "furniture"},
+    "": {"description", "duration_s", "seed", "laser", "lasers", "world", "robot", "people", "crowd", "visitors",
+         "furniture", "passers"},
     "laser": {"fov_deg", "resolution_deg", "rate_hz", "range_min", "range_max", "noise_std", "dropout",
-              "dropout_value", "clockwise", "frame_id", "sweep_fraction"},
+              "dropout_value", "spurious", "clockwise", "frame_id", "sweep_fraction"},
     "world": {"room", "walls", "boxes", "pillars"},
-    "robot": {"start", "mount", "drive", "waypoints", "speed", "max_turn_degps", "odometry_noise", "follow"},
-    "robot.follow": {"person", "distance", "max_speed"},
+    "robot": {"start", "mount", "drive", "waypoints", "speed", "max_turn_degps", "odometry_noise", "follow",
+              "odometry"},
+    "robot.follow": {"person", "distance", "max_speed", "max_turn_degps", "trail", "hold", "beside"},
+    "robot.follow.hold": {"at", "radius_m", "seconds"},
+    "robot.follow.beside": {"windows", "offset_m"},
     "robot.odometry_noise": {"trans", "rot"},
-    "people[]": {"id", "path", "speed", "start_s", "pauses", "exit", "round_radius"},
+    "people[]": {"id", "path", "speed", "start_s", "pauses", "exit", "round_radius", "laps"},
+    "passers": {"person", "per_minute", "speed", "offset_m", "half_width_m", "same_build", "start_s", "heading"},
     "crowd": {"count", "area", "speed", "waypoints", "pause_s", "pause_probability"},
     "visitors": {"count", "door", "area", "range_m", "stand_s", "arrive_every_s", "speed", "face_to_face",
                  "distance_m"},
@@ -112,9 +129,23 @@ def _check_keys(spec: dict) -> None:
     for sec in ("laser", "world", "robot", "crowd", "visitors", "furniture"):
         if sec in spec:
             check(spec[sec], sec)
+    for group in _as_list(spec.get("passers")):
+        check(group, "passers")
+    if "lasers" in spec:
+        if not isinstance(spec["lasers"], dict):
+            raise ScenarioError("scenario key 'lasers' must be a mapping of names to lasers")
+        for name, laser in spec["lasers"].items():
+            if not isinstance(laser, dict):
+                raise ScenarioError(f"scenario key 'lasers.{name}' must be a mapping")
+            for k in laser:
+                if k not in _KEYS["laser"]:
+                    raise ScenarioError(f"unknown scenario key 'lasers.{name}.{k}'")
     for sub in ("odometry_noise", "follow"):
         if sub in (spec.get("robot") or {}):
             check(spec["robot"][sub], f"robot.{sub}")
+    for sub in ("hold", "beside"):
+        if sub in ((spec.get("robot") or {}).get("follow") or {}):
+            check(spec["robot"]["follow"][sub], f"robot.follow.{sub}")
     for i, person in enumerate(spec.get("people", []) or []):
         if not isinstance(person, dict):
             raise ScenarioError(f"scenario key 'people[{i}]' must be a mapping")
@@ -154,6 +185,7 @@ def build_laser(spec: dict) -> LaserModel:
         noise_std=_num(spec, "noise_std", 0.01, w, 0.0, 1.0),
         dropout=_num(spec, "dropout", 0.0, w, 0.0, 1.0),
         dropout_value=float("nan") if dv == "nan" else 0.0,
+        spurious=_num(spec, "spurious", 0.0, w, 0.0, 1.0),
         clockwise=bool(spec.get("clockwise", False)),
         frame_id=str(spec.get("frame_id", "laser")),
         sweep_fraction=_num(spec, "sweep_fraction", 0.75, w, 0.0, 1.0),
@@ -173,6 +205,12 @@ def _walker(i: int, p: dict, rng: np.random.Generator) -> Walker:
     if path.ndim != 2 or path.shape[1] != 2 or len(path) < 1:
         raise ScenarioError(f"scenario key '{where}path' must be a list of [x, y]")
     pauses = {int(k): float(v) for k, v in (p.get("pauses") or {}).items()}
+    laps = int(_num(p, "laps", 1, where, 1, 1000))
+    if laps > 1:  # the path again from its start, pauses and speeds with it
+        pauses = {i + k * len(path): s for k in range(laps) for i, s in pauses.items()}
+        if isinstance(speed, list):
+            speed = ((speed + [speed[-1]]) * laps)[:-1]  # the leg back to the start at the last speed
+        path = np.vstack([path] * laps)
     radius = p.get("round_radius")
     return Walker(int(p.get("id", i + 1)), path, speed, pauses, _num(p, "start_s", 0.0, where, 0.0),
                   bool(p.get("exit", False)), PersonModel.sample(rng, float(np.mean(speeds))),
@@ -319,14 +357,65 @@ def _visitors(spec: dict, first_id: int, rng: np.random.Generator, sensor: np.nd
     return out
 
 
-def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | None = None) -> tuple[Simulation, int]:
+def _passers(spec: dict, first_id: int, rng: np.random.Generator, person: Walker, duration_s: float) -> list[Walker]:
+    """People who cross ``person``'s path ``offset_m`` ahead of them (negative: behind) and leave."""
+    w = "passers."
+    per_minute = _num(spec, "per_minute", 3.0, w, 0.0, 600.0)
+    v_lo, v_hi = _interval(spec, "speed", [0.9, 1.5], w, lo=0.1)
+    try:
+        o_lo, o_hi = (float(a) for a in spec.get("offset_m", [-1.2, -0.5]))
+    except (TypeError, ValueError):
+        raise ScenarioError(f"scenario key '{w}offset_m' must be [lo, hi]") from None
+    half = _num(spec, "half_width_m", 4.0, w, 0.5, 100.0)
+    same = bool(spec.get("same_build", False))
+    heading = spec.get("heading", "across")
+    if heading not in ("across", "oncoming"):
+        raise ScenarioError(f"scenario key '{w}heading' must be across or oncoming, got {heading!r}")
+    out: list[Walker] = []
+    if per_minute <= 0:
+        return out
+    t = _num(spec, "start_s", 5.0, w, 0.0)
+    while True:
+        t += float(rng.uniform(0.5, 1.5)) * 60.0 / per_minute
+        if t >= duration_s:
+            return out
+        speed = float(rng.uniform(v_lo, v_hi))
+        body = PersonModel.sample(rng, speed)
+        if same:
+            body = PersonModel(person.body.leg_radius, person.body.leg_spacing, body.step_length)
+        offset, side = float(rng.uniform(o_lo, o_hi)), float(rng.choice([-1.0, 1.0]))
+        if not person.present(t):
+            continue
+        where, u = person._at(person.arc_length(t))
+        n = side * np.array([-u[1], u[0]])
+        if heading == "across":
+            cross, d = where + offset * u, n
+        else:  # they meet where the person is at t, offset to one side, walking the other way
+            cross, d = where + abs(offset) * n, -u
+        start = t - half / speed
+        if start < 0:
+            continue
+        out.append(Walker(first_id + len(out), np.array([cross - half * d, cross + half * d]), speed, {}, start,
+                          True, body))
+
+
+def laser_names(spec: dict) -> list[str]:
+    """Names of the other lasers a scenario can run with (its ``lasers`` section)."""
+    return list((spec.get("lasers") or {}).keys())
+
+
+def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | None = None,
+                     laser: str | None = None) -> tuple[Simulation, int]:
     """The simulation of a scenario and its number of scans.
 
-    ``seed`` and ``crowd_count`` override the scenario's own values.
+    ``seed`` and ``crowd_count`` override the scenario's own values; ``laser`` names one of
+    its ``lasers`` to use instead of ``laser``.
     """
     seed = int(spec.get("seed", 0) if seed is None else seed)
     rng = np.random.default_rng(seed)
-    laser = build_laser(spec.get("laser", {}) or {})
+    if laser is not None and laser not in laser_names(spec):
+        raise ScenarioError(f"no laser '{laser}' in the scenario (it has: {', '.join(laser_names(spec)) or 'none'})")
+    laser = build_laser((spec.get("laser", {}) if laser is None else spec["lasers"][laser]) or {})
     try:
         world = build_world(spec.get("world"))
     except (TypeError, ValueError):
@@ -357,16 +446,59 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
     if "visitors" in spec:
         walkers += _visitors(spec["visitors"] or {}, 1 + max([w.person_id for w in walkers], default=0), rng,
                              sensor_xy, furniture)
+    duration = _num(spec, "duration_s", 20.0, "", 0.0, 86400.0, lo_open=True)
+    target_id = None
     if "follow" in robot:
         f = robot["follow"]
         target = next((w for w in walkers if w.person_id == f.get("person")), None)
         if target is None:
             raise ScenarioError(f"scenario key 'robot.follow.person': no person with id {f.get('person')!r}")
+        target_id = target.person_id
         driver = FollowDriver(lambda t, w=target: w.torso(t) if w.present(t) else None,
                               _num(f, "distance", 1.0, "robot.follow.", 0.1, 20.0),
-                              _num(f, "max_speed", 1.2, "robot.follow.", 0.0, 5.0))
-    duration = _num(spec, "duration_s", 20.0, "", 0.0, 86400.0, lo_open=True)
+                              _num(f, "max_speed", 1.2, "robot.follow.", 0.0, 5.0),
+                              math.radians(_num(f, "max_turn_degps", 1.0, "robot.follow.", 1.0, 1000.0))
+                              if "max_turn_degps" in f else 1.5,
+                              bool(f.get("trail", False)), _hold(f.get("hold")), _beside(f.get("beside")))
+    for p in _as_list(spec.get("passers")):
+        pid = p.get("person", target_id if target_id is not None else walkers[0].person_id if walkers else None)
+        person = next((w for w in walkers if w.person_id == pid), None)
+        if person is None:
+            raise ScenarioError(f"scenario key 'passers.person': no person with id {pid!r}")
+        walkers += _passers(p, 1 + max(w.person_id for w in walkers), rng, person, duration)
     sim = Simulation(laser, world, walkers, rng, mount=mount, start=start, driver=driver,
                      odom_trans_noise=_num(noise, "trans", 0.0, "robot.odometry_noise.", 0.0, 1.0),
-                     odom_rot_noise=_num(noise, "rot", 0.0, "robot.odometry_noise.", 0.0, 1.0))
+                     odom_rot_noise=_num(noise, "rot", 0.0, "robot.odometry_noise.", 0.0, 1.0),
+                     has_odometry=bool(robot.get("odometry", True)), target_id=target_id)
     return sim, int(round(duration * laser.rate_hz))
+
+
+def _as_list(section) -> list:
+    """A section that may be one mapping or a list of them (``passers``)."""
+    if section is None:
+        return []
+    return list(section) if isinstance(section, list) else [section]
+
+
+def _hold(spec: dict | None):
+    """``robot.follow.hold`` as (points (k, 2), radius_m, seconds), or None."""
+    if not spec:
+        return None
+    w = "robot.follow.hold."
+    try:
+        points = np.array(spec.get("at", []), dtype=float).reshape(-1, 2)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"scenario key '{w}at' must be a list of [x, y]") from None
+    return points, _num(spec, "radius_m", 0.5, w, 0.01, 100.0), _num(spec, "seconds", 2.0, w, 0.0, 3600.0)
+
+
+def _beside(spec: dict | None):
+    """``robot.follow.beside`` as ([(t0, t1), …], offset_m), or None."""
+    if not spec:
+        return None
+    w = "robot.follow.beside."
+    try:
+        windows = [(float(a), float(b)) for a, b in spec.get("windows", [])]
+    except (TypeError, ValueError):
+        raise ScenarioError(f"scenario key '{w}windows' must be a list of [t0, t1]") from None
+    return windows, _num(spec, "offset_m", 1.0, w, 0.1, 10.0)

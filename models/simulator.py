@@ -112,6 +112,10 @@ class Simulation:
         Odometry messages per second.
     t0 : float
         Stamp of the first scan, seconds.
+    has_odometry : bool
+        Whether a recording of the scene carries the odometry (the robot has it either way).
+    target_id : int or None
+        The person the robot follows, if it follows one.
     """
 
     laser: LaserModel
@@ -126,6 +130,8 @@ class Simulation:
     odom_rate_hz: float = 50.0
     t0: float = 1000.0
     physics_hz: float = 200.0
+    has_odometry: bool = True
+    target_id: int | None = None
 
     def __post_init__(self) -> None:
         self.index = 0

@@ -123,7 +123,11 @@ def _build_parser() -> argparse.ArgumentParser:
     ev.add_argument("tracks", metavar="TRACKS.csv", help="needs the columns scan_index,track_id,x,y")
     ev.add_argument("--ground-truth", required=True, metavar="BAG|GT.csv",
                     help="an annotated recording or a ground-truth CSV (scan_index,person_id,x,y)")
-    ev.add_argument("--protocol", choices=("general", "following"), default="general")
+    ev.add_argument("--protocol", choices=("general", "following"), default="general",
+                    help="general: everyone; following: the followed person over all tracks, and the "
+                         "tracker's target (its target column) against them")
+    ev.add_argument("--target-person", type=int, metavar="ID",
+                    help="the followed person's id, when the ground truth holds everyone (following)")
     ev.add_argument("--threshold", type=float, default=0.75, metavar="M", help="match distance, metres (0.75)")
     ev.add_argument("--topic", help="scan topic of the annotated recording (every scan is a frame)")
     ev.add_argument("--gt-topic", help="ground-truth topic (leg_tracker/Person) of the recording")
@@ -141,6 +145,7 @@ def _build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--seed", type=int, help="override the scenario's seed")
     sim.add_argument("--people", type=int, help="number of crowd walkers (crowd scenes)")
     sim.add_argument("--duration", type=float, metavar="S", help="override the scenario's duration, seconds")
+    sim.add_argument("--laser", metavar="NAME", help="one of the scenario's other lasers (its 'lasers' section)")
     sim.add_argument("--format", choices=("mcap", "sqlite3", "ros1"), default="mcap",
                      help="ROS 2 bag storage (mcap, sqlite3) or a ROS 1 .bag (default: mcap)")
     tl = sub.add_parser("train-legs", help="fit the leg model to your own laser's recordings ([train] extra)", parents=[common])
@@ -395,8 +400,10 @@ def _cmd_evaluate(args) -> int:
     gt = read_ground_truth(args.ground_truth, args.topic, args.gt_topic)
     for reason in frame_mismatches(gt, tracks):
         logging.getLogger(PROG).warning(reason)
+    if args.target_person is not None and args.protocol != "following":
+        raise InputError("--target-person needs --protocol following")
     result = evaluate(gt, tracks, args.protocol, args.threshold, args.ospa_cutoff, args.ospa_order,
-                      bearing_window_deg=None if window is None else tuple(window))
+                      bearing_window_deg=None if window is None else tuple(window), target_person=args.target_person)
     result["tracks_file"] = str(args.tracks)
     result["ground_truth_file"] = str(args.ground_truth)
     print(format_table(result))
@@ -417,10 +424,16 @@ def _cmd_simulate(args) -> int:
     t0 = time.perf_counter()
     with _progress(None, args.quiet) as bar:
         bag, gt, n, rows = simulate_to_bag(args.scenario, args.output, args.seed, args.people, args.duration,
-                                           args.format, progress=bar.update)
-    print(f"wrote {bag} ({n} scans on /scan, /odom, /tf, /tf_static; {args.format}) and {gt} "
+                                           args.format, progress=bar.update, laser=args.laser)
+    topics = "/scan, /odom, /tf, /tf_static" if _scene_has_odometry(args.scenario) else "/scan, /tf_static"
+    print(f"wrote {bag} ({n} scans on {topics}; {args.format}) and {gt} "
           f"({rows} visible people) in {time.perf_counter() - t0:.1f} s")
     return 0
+
+
+def _scene_has_odometry(scenario: str) -> bool:
+    from people_tracker.models.scenario import load_scenario
+    return bool((load_scenario(scenario).get("robot") or {}).get("odometry", True))
 
 
 def _cmd_bench(args) -> int:

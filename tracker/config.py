@@ -89,6 +89,7 @@ class PairingConfig:
     sigma_pair_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     sigma_single_leg_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     sigma_blob_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
+    max_leg_radius_m: float = field(metadata=_spec(lo=0.0, hi=1.0))
 
     def params(self):
         from people_tracker.tracker.pairing import PairingParams
@@ -170,6 +171,7 @@ class AssociationConfig:
     free_space_lookback_s: float = field(metadata=_spec(lo=0.0, hi=60.0))
     free_space_margin_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
     recover_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
+    start_leg_probability: float = field(metadata=_spec(lo=0.0, hi=1.01))
 
     def params(self):
         from people_tracker.tracker.people_tracker import AssociationParams

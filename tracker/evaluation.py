@@ -6,9 +6,14 @@ Protocols (Leigh et al.):
   (CLEAR MOT's assignment, keeping last frame's matches while they stay in range);
   ``MOTA = 1 - (misses + false positives + id switches) / ground-truth people``, ``MOTP``
   the mean distance of the matches in metres.
-* ``following``: the ground truth holds only the followed person; the tracks are the
-  target's (rows with ``target == 1`` when the file says which). False positives are
-  counted but do not lower MOTA: ``MOTA = 1 - (misses + id switches) / ground truth``.
+* ``following``: Leigh et al.'s figures for the followed person over all tracks — the
+  ground truth holds only them (Leigh's recordings), or everyone with the person named
+  (``target_person``, or the simulator's ``target`` column). False positives are counted but
+  do not lower MOTA: ``MOTA = 1 - (misses + id switches) / ground truth``. From the rows the
+  tracker marked ``target``, target continuity (:func:`target_continuity`): the share of the
+  person's visible scans after the first lock with the target within ``threshold`` of them,
+  the scans with the target on someone or something else, the target changes and the time
+  to the first lock.
 
 Every scan is a frame, including scans where nobody is annotated (a reported person
 there is a false positive). Positions are compared in the sensor frame.
@@ -34,7 +39,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from people_tracker.models.pose import pairwise_distances
-from people_tracker.tracker.errors import require
+from people_tracker.tracker.errors import InputError, require
 from people_tracker.tracker.io.ground_truth import GroundTruth
 
 
@@ -47,6 +52,7 @@ class TrackRows:
     x: np.ndarray
     y: np.ndarray
     target: np.ndarray | None = None  # 1 for the followed person, when the file says
+    stamp: np.ndarray | None = None  # the scan's stamp (s), when the file says
 
     def __len__(self) -> int:
         return int(self.scan_index.shape[0])
@@ -119,9 +125,81 @@ def without_hidden(gt: GroundTruth, hidden: GroundTruth, tracks: TrackRows, thre
     return _rows_where(tracks, keep), int((~keep).sum())
 
 
+def followed_person(gt: GroundTruth, target_person: int | None = None) -> int:
+    """The id of the followed person: ``target_person``, the one the ground truth marks, or
+    the only one in it; an :class:`InputError` when it cannot say."""
+    ids = np.unique(gt.person_id)
+    if target_person is not None:
+        if target_person not in ids:
+            raise InputError(f"--target-person {target_person} is not in the ground truth "
+                             f"(it holds {', '.join(map(str, ids[:10].tolist())) or 'nobody'})")
+        return int(target_person)
+    if gt.target is not None and (gt.target == 1).any():
+        marked = np.unique(gt.person_id[gt.target == 1])
+        if len(marked) == 1:
+            return int(marked[0])
+    if len(ids) == 1:
+        return int(ids[0])
+    raise InputError(f"the ground truth holds {len(ids)} people and does not say whom the robot follows: "
+                     "name them with --target-person ID")
+
+
+def target_continuity(person: GroundTruth, others: GroundTruth, tracks: TrackRows, threshold: float) -> dict:
+    """How well the tracker's target stays on the followed person.
+
+    ``person`` holds the followed person's visible scans, ``others`` everyone else's; the
+    target is the track rows marked ``target == 1`` (one per scan). The first lock is the
+    first visible scan with the target within ``threshold`` of the person. After it:
+    ``target_on_person`` is the share of the person's visible scans with the target on them;
+    ``target_wrong_scans`` counts scans with the target farther than ``threshold`` from the
+    visible person, or, while they are not visible, within ``threshold`` of someone else;
+    ``target_changes`` counts changes of the target's track id (over the whole run);
+    ``first_lock_s`` is the time from the person's first visible scan to the first lock,
+    seconds (from the tracks' stamps; NaN without them or without a lock).
+    """
+    nan = float("nan")
+    out = {"target_person_scans": int(len(person)), "first_lock_scan": None, "first_lock_s": nan,
+           "target_on_person": nan, "target_wrong_scans": None, "target_changes": None}
+    if tracks.target is None:
+        return out
+    sel = np.flatnonzero(tracks.target == 1)
+    sel = sel[np.argsort(tracks.scan_index[sel], kind="stable")]
+    scans, first = np.unique(tracks.scan_index[sel], return_index=True)
+    sel = sel[first]  # one target row per scan
+    ids = tracks.track_id[sel]
+    out["target_changes"] = int((ids[1:] != ids[:-1]).sum())
+    where = {int(k): (float(x), float(y)) for k, x, y in zip(scans, tracks.x[sel], tracks.y[sel])}
+    p_scan = person.scan_index
+    d = np.array([np.hypot(where[k][0] - x, where[k][1] - y) if k in where else np.inf
+                  for k, x, y in zip(p_scan.tolist(), person.x, person.y)])
+    on = d <= threshold
+    if not on.any():
+        out["target_on_person"], out["target_wrong_scans"] = 0.0, int(len(scans))
+        return out
+    lock = int(p_scan[np.argmax(on)])
+    after = p_scan >= lock
+    out["first_lock_scan"] = lock
+    out["target_on_person"] = float(on[after].mean())
+    visible = set(p_scan.tolist())
+    wrong = int((~on[after] & np.isfinite(d[after])).sum())
+    o_rows = _by_frame(others.scan_index, int(max(scans.max(initial=-1), others.scan_index.max(initial=-1))) + 1)
+    for k in scans[scans >= lock].tolist():
+        if k in visible or k >= len(o_rows) or not len(o_rows[k]):
+            continue
+        r = o_rows[k]
+        if (np.hypot(others.x[r] - where[k][0], others.y[r] - where[k][1]) <= threshold).any():
+            wrong += 1
+    out["target_wrong_scans"] = wrong
+    if tracks.stamp is not None and len(np.unique(tracks.scan_index)) >= 2:
+        slope, offset = np.polyfit(tracks.scan_index.astype(float), tracks.stamp, 1)
+        out["first_lock_s"] = float(slope * (lock - int(p_scan[0])))
+    return out
+
+
 def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", threshold: float = 0.75,
              ospa_cutoff: float = 1.0, ospa_order: float = 1.0, n_frames: int | None = None,
-             bearing_window_deg: tuple[float, float] | None = None, hidden: GroundTruth | None = None) -> dict:
+             bearing_window_deg: tuple[float, float] | None = None, hidden: GroundTruth | None = None,
+             target_person: int | None = None) -> dict:
     """Score ``tracks`` against ``gt``.
 
     Parameters
@@ -139,21 +217,27 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
         Keep only people and tracks whose sensor-frame bearing lies in [min, max], degrees.
     hidden : GroundTruth, optional
         People who are there but hidden: tracks on them are ignored (see the module docstring).
+    target_person : int, optional
+        The followed person's id (``following``), when the ground truth holds everyone.
 
     Returns
     -------
     dict
         frames, ground_truth, matches, misses, false_positives, id_switches, mota, motp (m),
-        idf1, ospa (m, mean over frames), and the protocol and parameters used.
+        idf1, ospa (m, mean over frames), and the protocol and parameters used; for
+        ``following`` also target_person and the figures of :func:`target_continuity`.
     """
     # imported here: pandas is slow to import and only evaluation needs it
     mm = require("motmetrics", "eval", "evaluation (CLEAR MOT, IDF1)")
 
     if protocol not in ("general", "following"):
         raise ValueError(f"protocol must be general or following, got {protocol!r}")
-    if protocol == "following" and tracks.target is not None:
-        keep = tracks.target == 1
-        tracks = TrackRows(tracks.scan_index[keep], tracks.track_id[keep], tracks.x[keep], tracks.y[keep], tracks.target[keep])
+    following = {}
+    if protocol == "following":
+        pid = followed_person(gt, target_person)
+        others = _rows_where(gt, gt.person_id != pid)
+        gt = _rows_where(gt, gt.person_id == pid)
+        following = {"target_person": pid, **target_continuity(gt, others, tracks, threshold)}
     ignored = 0
     if hidden is not None and len(hidden) and protocol == "general":
         tracks, ignored = without_hidden(gt, hidden, tracks, threshold)
@@ -201,6 +285,7 @@ def evaluate(gt: GroundTruth, tracks: TrackRows, protocol: str = "general", thre
         "ospa_cutoff_m": ospa_cutoff,
         "ospa_order": ospa_order,
         "bearing_window_deg": None if bearing_window_deg is None else [float(b) for b in bearing_window_deg],
+        **following,
     }
 
 
@@ -239,5 +324,18 @@ def format_table(result: dict) -> str:
         ("IDF1", pct(result["idf1"])),
         (f"OSPA (c={result['ospa_cutoff_m']:g} m, p={result['ospa_order']:g})", metres(result["ospa_m"])),
     ]
+    if result["protocol"] == "following":
+        lock = result.get("first_lock_scan")
+        lines += [
+            ("followed person", f"{result['target_person']} ({result['target_person_scans']} visible scans)"),
+            ("first lock", "never" if lock is None else f"scan {lock}" + (
+                "" if result["first_lock_s"] != result["first_lock_s"] else f", {result['first_lock_s']:.2f} s "
+                "after they are first visible")),
+            ("target on the person", "n/a (no target column)" if result["target_changes"] is None
+             else pct(result["target_on_person"]) + " of their visible scans after the first lock"),
+            ("target elsewhere", "n/a" if result["target_wrong_scans"] is None
+             else f"{result['target_wrong_scans']} scans (on someone or something else)"),
+            ("target changes", "n/a" if result["target_changes"] is None else f"{result['target_changes']}"),
+        ]
     width = max(len(k) for k, _ in lines)
     return "\n".join(f"{k:<{width}}  {v}" for k, v in lines)

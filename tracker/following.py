@@ -1,4 +1,13 @@
-"""Choosing and keeping the person a robot follows."""
+"""Choosing and keeping the person a robot follows.
+
+The target model lives in the sensor frame: a robot that follows someone keeps them at much
+the same place in front of it, whatever it knows of its own motion (without odometry, in a
+scene that gives scan matching little to hold on to, the world frame drifts and jumps; the
+person's place relative to the sensor does not). When the target's track breaks off, or
+coasts while a fresh track appears where the person should be, the person's id goes to the
+track at that place — when exactly one is there; when more than one could be them, the
+person is reported lost rather than swapped for someone else.
+"""
 
 from __future__ import annotations
 
@@ -6,68 +15,123 @@ import math
 
 import numpy as np
 
-from people_tracker.models.pose import Pose2D
-
 
 class TargetSelector:
-    """Keeps one target track id.
+    """Keeps one target track id, and the person's id when their track breaks.
 
     Parameters
     ----------
     mode : 'auto', an int track id, or None
-        ``auto`` picks the closest confirmed person ahead of the sensor (within
-        ``ahead_deg`` of its x axis) whenever there is no target; an id follows that
-        track once it exists.
-    reacquire_s, reacquire_m : float
-        When the target's track is deleted, a new confirmed track that appears within
-        ``reacquire_s`` seconds and ``reacquire_m`` metres of the target's last estimate
-        takes over the target's id: the person is reported re-acquired under the same id.
+        ``auto`` locks onto the closest reported person ahead of the sensor (within
+        ``ahead_deg`` of its x axis and ``lock_range_m`` of it: the person to follow stands
+        or walks close in front of the robot) whenever there is no target; an id follows
+        that track once it exists.
+    reacquire_s : float
+        How long (s) after the target's track broke off another track may still take the
+        person's id; then an ``auto`` selector locks anew.
+    reacquire_m, walk_mps : float
+        Another track takes the id when it lies within ``reacquire_m`` metres of where the
+        person should be relative to the sensor, the radius growing at ``walk_mps`` with the
+        time since their track was last updated, up to ``max_reach_m``.
+    coast_s : float
+        A target track not updated for this long (s), while exactly one other track was
+        updated where the person should be, gives the id to that one.
+    steady_s, slide_m : float
+        The person's place relative to the sensor averaged over ``steady_s`` seconds: a
+        target track that moved more than ``slide_m`` from it, while exactly one other track
+        was updated within ``reacquire_m`` of it, slid onto someone passing between; the
+        id goes to that one.
     """
 
-    def __init__(self, mode: str | int | None, reacquire_s: float = 5.0, reacquire_m: float = 1.5,
-                 ahead_deg: float = 60.0) -> None:
+    def __init__(self, mode: str | int | None, reacquire_s: float = 10.0, reacquire_m: float = 0.8,
+                 ahead_deg: float = 60.0, lock_range_m: float = 3.5, walk_mps: float = 0.7,
+                 coast_s: float = 0.5, max_reach_m: float = 4.0, steady_s: float = 1.5,
+                 slide_m: float = 0.6) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
-        self._lost: tuple[float, np.ndarray] | None = None  # (stamp, last position) of a deleted target
-        self._reacquire_s, self._reacquire_m = reacquire_s, reacquire_m
-        self._ahead = math.radians(ahead_deg)
+        self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
+        self._ahead, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
+        self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
+        self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
+        self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
+        self._v = np.zeros(2)  # ... its rate of change (m/s) ...
+        self._t: float | None = None  # ... and when their track was last updated (s)
+        self.lost_since: float | None = None  # when the target's track broke off, while it is missing
         self.events: list[str] = []
 
-    def lost(self, stamp: float, position: np.ndarray) -> None:
-        """The target's track was deleted at ``stamp`` (s), last seen at ``position`` (world, m)."""
-        self._lost = (stamp, position.copy())
-        self.events.append(f"lost {self.target}")
+    def seen(self, stamp: float, q: np.ndarray) -> None:
+        """The target's track was updated at ``stamp`` (s), at ``q`` in the sensor frame (m)."""
+        q = np.asarray(q, dtype=float)
+        if self._q is not None and self._t is not None and stamp > self._t:
+            rate = (q - self._q) / (stamp - self._t)
+            speed = float(np.hypot(*rate))
+            if speed > 2.0:
+                rate *= 2.0 / speed
+            self._v = 0.7 * self._v + 0.3 * rate
+            a = 1.0 - math.exp(-(stamp - self._t) / self._steady_s)
+            self.steady = self.steady + a * (q - self.steady)
+        else:
+            self.steady = q.copy()
+        self._q, self._t = q.copy(), stamp
+        self.lost_since = None
 
-    def reacquire(self, stamp: float, new_tracks: dict[int, np.ndarray]) -> int | None:
-        """Which newly confirmed track (id → world position) takes over the lost target's id, if any."""
-        if self._lost is None or self.target is None:
+    def lost(self, stamp: float) -> None:
+        """The target's track broke off (or was found on someone else) at ``stamp`` (s)."""
+        if self.lost_since is None:
+            self.lost_since = stamp
+            self.events.append(f"lost {self.target}")
+
+    def expected(self, stamp: float) -> tuple[np.ndarray, float] | None:
+        """Where the person should be now in the sensor frame (m), and how far from it they may be (m)."""
+        if self._q is None or self._t is None:
             return None
-        t_lost, where = self._lost
-        if stamp - t_lost > self._reacquire_s:
-            self._lost = None
+        gap = max(stamp - self._t, 0.0)
+        return self._q + self._v * min(gap, 1.0), min(self._reacquire_m + self._walk * gap, self._max_reach)
+
+    def within_reach(self, stamp: float, q: np.ndarray) -> bool:
+        """Whether the person could be at ``q`` (sensor frame, m) now."""
+        exp = self.expected(stamp)
+        return exp is None or float(np.hypot(*(np.asarray(q) - exp[0]))) <= exp[1]
+
+    def only_one_near(self, stamp: float, others: dict[int, np.ndarray], steady: bool = False) -> int | None:
+        """The one track (id → sensor-frame place) where the person should be (or, with
+        ``steady``, within ``reacquire_m`` of where they have been lately); None when there
+        is none or more than one."""
+        exp = self.expected(stamp)
+        if exp is None:
+            return None
+        where, reach = (self.steady, self._reacquire_m) if steady else exp
+        near = [tid for tid, q in others.items() if float(np.hypot(*(q - where))) <= reach]
+        return near[0] if len(near) == 1 else None
+
+    def slid(self, q: np.ndarray) -> bool:
+        """Whether the target track at ``q`` (sensor frame, m) is far from where the person has been lately."""
+        return self.steady is not None and float(np.hypot(*(np.asarray(q) - self.steady))) > self.slide_m
+
+    def reacquire(self, stamp: float, others: dict[int, np.ndarray]) -> int | None:
+        """Which other track (id → sensor-frame place) takes over the missing target's id."""
+        if self.lost_since is None or self.target is None:
+            return None
+        if stamp - self.lost_since > self._reacquire_s:
+            self.events.append(f"gave up {self.target}")
+            self.lost_since = None
             if self.mode == "auto":
-                self.target = None
+                self.target, self._q, self._t, self._v, self.steady = None, None, None, np.zeros(2), None
             return None
-        best, best_d = None, self._reacquire_m
-        for tid, p in new_tracks.items():
-            d = float(np.hypot(*(p - where)))
-            if d <= best_d:
-                best, best_d = tid, d
+        best = self.only_one_near(stamp, others)
         if best is not None:
-            self._lost = None
+            self.lost_since = None
             self.events.append(f"re-acquired {self.target}")
         return best
 
-    def choose(self, confirmed: dict[int, np.ndarray], pose: Pose2D) -> int | None:
-        """The target id now, given confirmed tracks (id → world position) and the sensor pose."""
-        if self.target is not None or self.mode != "auto" or self._lost is not None:
+    def choose(self, reported: dict[int, np.ndarray]) -> int | None:
+        """The target id now, given reported tracks (id → sensor-frame place, m)."""
+        if self.target is not None or self.mode != "auto":
             return self.target
         best, best_r = None, math.inf
-        inv = pose.inverse()
-        for tid, p in confirmed.items():
-            x, y = inv.transform_points(p[None, :])[0]
+        for tid, (x, y) in reported.items():
             r, bearing = math.hypot(x, y), math.atan2(y, x)
-            if abs(bearing) <= self._ahead and r < best_r:
+            if abs(bearing) <= self._ahead and r <= self._lock_range and r < best_r:
                 best, best_r = tid, r
         if best is not None:
             self.target = best

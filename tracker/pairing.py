@@ -34,6 +34,8 @@ class PairingParams:
     sigma_pair_m, sigma_single_leg_m, sigma_blob_m : float
         Standard deviation of the torso position measured from a leg pair, one leg, or a
         person-sized object.
+    max_leg_radius_m : float
+        Largest leg radius: see :func:`leg_centres` (0 keeps the readings' hull centroid).
     """
 
     min_leg_size_m: float = 0.04
@@ -43,6 +45,7 @@ class PairingParams:
     sigma_pair_m: float = 0.08
     sigma_single_leg_m: float = 0.2
     sigma_blob_m: float = 0.12
+    max_leg_radius_m: float = 0.08
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,6 +74,28 @@ class PersonCandidate:
     def R(self) -> np.ndarray:
         """Measurement covariance, m²."""
         return np.eye(2) * self.sigma ** 2
+
+
+def leg_centres(means: np.ndarray, widths: np.ndarray, max_radius_m: float) -> np.ndarray:
+    """Where round legs' centres lie, from their readings (sensor frame, metres).
+
+    A laser sees the near half of a leg and samples it evenly across the beam (the leg is
+    far compared with its size), so the readings' mean lies π/4 of the radius in front of
+    the centre, along the beam. The radius is half the readings' width across the beam,
+    at most ``max_radius_m`` (a partly hidden leg shows less, and is stepped back less;
+    two merged legs step back one leg's radius).
+
+    Parameters
+    ----------
+    means : ndarray, shape (k, 2)
+        Mean of each leg's readings, sensor frame.
+    widths : ndarray, shape (k,)
+        Distance between each leg's first and last reading, metres.
+    """
+    means = np.asarray(means, dtype=float).reshape(-1, 2)
+    r = np.clip(0.5 * np.asarray(widths, dtype=float), 0.0, max_radius_m)
+    u = means / np.maximum(np.hypot(means[:, 0], means[:, 1]), 1e-9)[:, None]
+    return means + u * (0.25 * np.pi * r)[:, None]
 
 
 def owners(xy: np.ndarray, predictions: np.ndarray, radius: float) -> np.ndarray:

@@ -25,7 +25,7 @@ from people_tracker.models.scan import Scan
 from people_tracker.tracker.association import associate, mahalanobis_costs
 from people_tracker.tracker.existence import Existence, ExistenceParams
 from people_tracker.tracker.following import TargetSelector
-from people_tracker.tracker.pairing import PairingParams, PersonCandidate, owners, pair_legs
+from people_tracker.tracker.pairing import PairingParams, PersonCandidate, leg_centres, owners, pair_legs
 from people_tracker.tracker.standing import StandingInitiator, StandingParams, standing_pairs
 from people_tracker.tracker.static_support import static_support
 from people_tracker.tracker.tracks import Track, TrackParams, TrackState
@@ -55,6 +55,11 @@ class AssociationParams:
         place was empty: someone walked in). Static surfaces that look moving (misaligned,
         or flickering between a return and none) were never seen through. 0 s turns the
         test off.
+    start_leg_probability : float
+        A candidate where the leg model gives a leg at least this probability starts a
+        track even where no earlier scan saw the place empty: someone walking straight away
+        from a robot that follows them stays in their own shadow, and outdoors nothing
+        behind them returns a reading to see past.
     """
 
     method: str = "gnn"
@@ -67,6 +72,7 @@ class AssociationParams:
     free_space_lookback_s: float = 1.0
     free_space_margin_m: float = 0.3
     recover_radius_m: float = 0.8
+    start_leg_probability: float = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,9 +169,10 @@ class PeopleTracker:
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
         legs = leg_candidates(scan)  # 6. every leg candidate and its probability, by shape alone
         leg_scores = self.leg_model.probability(legs.features)
+        self._unmatchable_legs(scan, legs, leg_scores)
         self._legs_world = world.transform_points(legs.xy) if len(legs.xy) else np.zeros((0, 2))
         self._leg_scores = leg_scores
-        standing = self._standing_candidates(legs, leg_scores, world)  # 6b. standing people: leg pairs
+        standing = self._standing_candidates(scan, legs, leg_scores, world)  # 6b. standing people: leg pairs
         matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
         self._support(scan, world, matched_t)  # 7. static support for the rest
         self._weigh(scan, world)  # 7b. evidence of existence
@@ -179,6 +186,15 @@ class PeopleTracker:
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.reported]
         self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing, legs, leg_scores)
         return reported
+
+    def _unmatchable_legs(self, scan: Scan, legs: LegCandidates, scores: np.ndarray) -> None:
+        """Leg-shaped readings take no part in matching the next scan: legs walk."""
+        keep = scores >= self.assoc.start_leg_probability
+        if keep.any():
+            mask = np.zeros(scan.n_valid, dtype=bool)
+            for a, b in zip(legs.start[keep], legs.stop[keep]):
+                mask[a:b] = True
+            self.aligner.exclude_from_reference(mask)
 
     def _best_leg(self, xy_world: np.ndarray) -> np.ndarray:
         """The best leg probability among this scan's leg candidates within the support
@@ -277,7 +293,12 @@ class PeopleTracker:
         objs = detection.objects
         if not objs:
             return []
-        xy = world.transform_points(np.array([(o.x, o.y) for o in objs]))
+        if self.pairing.max_leg_radius_m > 0:  # leg centres, behind the readings
+            widths = np.array([np.hypot(*(o.points[-1] - o.points[0])) for o in objs])
+            xy = world.transform_points(leg_centres(np.array([o.points.mean(axis=0) for o in objs]), widths,
+                                                    self.pairing.max_leg_radius_m))
+        else:
+            xy = world.transform_points(np.array([(o.x, o.y) for o in objs]))
         # legs near a tracked walking person are that person's: never paired with another
         # person's. A person standing still owns no moving legs: those are a passer-by's.
         people = np.array([t.position for t in self._tracks if t.confirmed and not t.still]).reshape(-1, 2)
@@ -359,11 +380,18 @@ class PeopleTracker:
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
                 t.update(z, R, moving=False)
 
-    def _standing_candidates(self, legs: LegCandidates, scores: np.ndarray, world: Pose2D) -> list[PersonCandidate]:
+    def _standing_candidates(self, scan: Scan, legs: LegCandidates, scores: np.ndarray,
+                             world: Pose2D) -> list[PersonCandidate]:
         p = self.standing.params
         if not p.enabled:
             return []
-        mids = standing_pairs(legs.xy[scores >= p.min_leg_probability], p)
+        keep = scores >= p.min_leg_probability
+        xy = legs.xy[keep]
+        if self.pairing.max_leg_radius_m > 0 and len(xy):
+            pts = scan.valid_points
+            widths = np.hypot(*(pts[legs.stop[keep] - 1] - pts[legs.start[keep]]).T)
+            xy = leg_centres(xy, widths, self.pairing.max_leg_radius_m)
+        mids = standing_pairs(xy, p)
         xy = world.transform_points(mids) if len(mids) else mids
         return [PersonCandidate(float(x), float(y), self.pairing.sigma_pair_m, "standing") for x, y in xy]
 
@@ -429,7 +457,11 @@ class PeopleTracker:
         fresh = [ci for ci in range(len(candidates)) if ci not in used]
         free = np.ones(len(candidates), dtype=bool)
         if fresh and self.assoc.free_space_lookback_s > 0:
-            free[fresh] = self._seen_empty(np.array([(candidates[ci].x, candidates[ci].y) for ci in fresh]), stamp)
+            xy = np.array([(candidates[ci].x, candidates[ci].y) for ci in fresh])
+            # a leg-shaped candidate needs no empty place: someone walking away in their own
+            # shadow, with nothing behind them to see past, was never seen arriving
+            free[fresh] = self._seen_empty(xy, stamp) | (np.nan_to_num(self._best_leg(xy)) >=
+                                                         self.assoc.start_leg_probability)
         self._spawn([c for ci, c in enumerate(candidates) if ci not in used and free[ci]], stamp)
 
     def _duplicates(self) -> set[int]:
@@ -474,24 +506,53 @@ class PeopleTracker:
         for t in dying:
             if t.furniture() and t.existence.probability >= self.existence.delete:
                 self.standing.furniture(t.position)
-            if not self._hand_over(t, keep, stamp) and self.selector is not None and t.track_id == self.selector.target:
-                self.selector.lost(stamp, t.position)
+            self._hand_over(t, keep, stamp)
         self._tracks = keep
 
     def _follow(self, world: Pose2D, stamp: float) -> int | None:
-        if self.selector is None:
+        """The followed person's track id (see :mod:`people_tracker.tracker.following`)."""
+        sel = self.selector
+        if sel is None:
             return None
-        confirmed = {t.track_id: t.position for t in self._tracks if t.reported}
-        if self.selector.target is not None and self.selector.target not in confirmed:
-            young = {t.track_id: t.position for t in self._tracks
-                     if t.reported and t.track_id > self.selector.target and stamp - t.born < 2.0}
-            new_id = self.selector.reacquire(stamp, young)
-            if new_id is not None:
-                for t in self._tracks:
-                    if t.track_id == new_id:
-                        t.track_id = self.selector.target  # the person keeps their id
-                confirmed = {t.track_id: t.position for t in self._tracks if t.reported}
-        return self.selector.choose(confirmed, world)
+        inv = world.inverse()
+
+        def here(tracks) -> dict[int, np.ndarray]:  # id -> place in the sensor frame (m)
+            return {u.track_id: inv.transform_points(u.position[None])[0] for u in tracks}
+
+        if sel.target is not None:
+            t = next((u for u in self._tracks if u.track_id == sel.target), None)
+            if t is not None and t.reported and not sel.within_reach(stamp, here([t])[t.track_id]):
+                t = self._retire(t)  # it is somewhere the person cannot be: on someone or something else
+            if t is not None and t.reported and t.updated_now and sel.slid(here([t])[t.track_id]):
+                # moved off where the person has been while another track is there: it slid onto a passer-by
+                if sel.only_one_near(stamp, here(u for u in self._tracks if u is not t and u.updated_now),
+                                     steady=True) is not None:
+                    t = self._retire(t)
+                    sel.lost(stamp)
+            if t is not None and t.reported and t.updated_now:
+                sel.seen(stamp, here([t])[t.track_id])
+            elif t is None or not t.reported:
+                sel.lost(stamp)
+            elif stamp - t.last_update >= sel.coast_s:
+                # coasting, while a track is updated where the person should be: that one is them
+                if sel.only_one_near(stamp, here(u for u in self._tracks if u is not t and u.updated_now)) is not None:
+                    t = self._retire(t)
+                    sel.lost(stamp)
+            if sel.lost_since is not None:
+                new_id = sel.reacquire(stamp, here(u for u in self._tracks if u.track_id != sel.target))
+                if new_id is not None:
+                    new = next(u for u in self._tracks if u.track_id == new_id)
+                    new.track_id, new.confirmed = sel.target, True  # the person keeps their id
+        reported = here(u for u in self._tracks if u.reported)
+        target = sel.choose(reported)
+        if target is not None and sel.expected(stamp) is None and target in reported:
+            sel.seen(stamp, reported[target])
+        return target
+
+    def _retire(self, t: TrackState) -> None:
+        """The track ``t`` goes on under a new id (it is no longer the followed person)."""
+        t.track_id, self._next_id = self._next_id, self._next_id + 1
+        return None
 
 
 def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:

@@ -55,13 +55,40 @@ def test_hand_worked_case():
     assert r["ospa_m"] == pytest.approx((0.15 + 1.3 / 3 + 0.5 + 1.0 + 1.0) / 5)
 
 
-def test_following_protocol_ignores_false_positives_and_other_tracks():
+def test_following_protocol_scores_the_person_over_all_tracks_and_the_target():
     target_only = gt_of([(k, 1, 1.0, 0.0) for k in range(5)], n_frames=5)
     r = evaluate(target_only, TRACKS, "following")
-    # target rows only (tracks 10 and 11): matched in frames 0, 1 (10) and 2 (11, a switch);
-    # frames 3 (1.0 m away: miss + false positive) and 4 (nothing): misses
-    assert (r["matches"], r["misses"], r["false_positives"], r["id_switches"]) == (3, 2, 1, 1)
+    # every track may match person 1: 10 in frames 0, 1, then 11 in frame 2 (a switch); frame 3
+    # (1.0 m away: a miss) and 4 (nothing): misses; tracks 20, 30 and the far 11 are false
+    # positives, counted but not in MOTA
+    assert (r["matches"], r["misses"], r["false_positives"], r["id_switches"]) == (3, 2, 4, 1)
     assert r["mota"] == pytest.approx(1 - (2 + 1) / 5)
+    # the target (rows marked 1): on person 1 in frames 0-2 of the 5 after the lock in frame 0,
+    # 1.0 m off in frame 3, changed from 10 to 11 once
+    assert r["target_person"] == 1 and r["first_lock_scan"] == 0
+    assert r["target_on_person"] == pytest.approx(3 / 5)
+    assert (r["target_wrong_scans"], r["target_changes"]) == (1, 1)
+
+
+def test_following_needs_to_know_whom_the_robot_follows():
+    from people_tracker.tracker.errors import InputError
+    with pytest.raises(InputError, match="--target-person"):
+        evaluate(GT, TRACKS, "following")
+    assert evaluate(GT, TRACKS, "following", target_person=2)["target_person"] == 2
+    marked = GroundTruth(GT.n_frames, GT.scan_index, GT.person_id, GT.x, GT.y, (GT.person_id == 2).astype(int))
+    assert evaluate(marked, TRACKS, "following")["target_person"] == 2
+    with pytest.raises(InputError, match="not in the ground truth"):
+        evaluate(GT, TRACKS, "following", target_person=7)
+
+
+def test_target_on_someone_else_while_the_person_is_hidden_is_wrong():
+    # person 1 visible in frames 0-1 only; person 2 at (3, 0) throughout; the target jumps to them
+    gt = gt_of([(0, 1, 1.0, 0.0), (1, 1, 1.0, 0.0)] + [(k, 2, 3.0, 0.0) for k in range(4)], n_frames=4)
+    tr = TrackRows(np.array([0, 1, 2, 3]), np.array([5, 5, 5, 5]), np.array([1.0, 1.0, 3.0, 1.0]),
+                   np.zeros(4), np.ones(4, dtype=int), np.array([0.0, 0.1, 0.2, 0.3]))
+    r = evaluate(gt, tr, "following", target_person=1)
+    assert r["target_on_person"] == 1.0 and r["first_lock_s"] == pytest.approx(0.0)
+    assert (r["target_wrong_scans"], r["target_changes"]) == (1, 0)  # frame 2 on person 2; frame 3 on nobody
 
 
 def test_ground_truth_against_itself_is_perfect():

@@ -234,8 +234,10 @@ def test_a_person_standing_from_the_first_scan_is_not_reported_until_they_walk()
                                                  "speed": 1.0}]}
     r, _, trk = run_scene(spec)
     assert r["false_positives"] == 0 and r["id_switches"] == 0, r
-    assert r["misses"] <= 50 + 8, r  # 5 s standing, then found within 0.8 s of walking
-    assert r["matches"] >= 40
+    # not reported while they stand (5 s), found within 1.2 s of walking (a leg-shaped
+    # moving candidate starts their track at once; its existence needs them to walk)
+    assert 50 <= r["misses"] <= 50 + 12, r
+    assert r["matches"] == r["ground_truth"] - r["misses"]
 
 
 def test_a_person_who_walks_in_and_stands_for_minutes_keeps_their_track():

@@ -34,6 +34,9 @@ class GroundTruth:
     scan_index, person_id : ndarray of int, shape (m,)
     x, y : ndarray of float, shape (m,)
         Person (torso) position in the scan's sensor frame, metres.
+    target : ndarray of int, shape (m,), or None
+        1 on the rows of the person the robot follows, when the source says (the
+        simulator's ``target`` column).
     """
 
     n_frames: int | None
@@ -41,6 +44,7 @@ class GroundTruth:
     person_id: np.ndarray
     x: np.ndarray
     y: np.ndarray
+    target: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.scan_index.shape[0])
@@ -97,10 +101,17 @@ def read_bag_ground_truth(path: str | Path, scan_topic: str | None = None,
 
 
 def read_gt_csv(path: str | Path) -> GroundTruth:
-    """Ground truth from a CSV with the header ``scan_index,person_id,x,y`` (extra columns ignored)."""
+    """Ground truth from a CSV with the header ``scan_index,person_id,x,y`` (a ``target``
+    column is read when present; other extra columns are ignored)."""
     rows = read_rows(path, "ground truth", GT_COLUMNS, lambda row: (
-        int(row["scan_index"]), int(row["person_id"]), float(row["x"]), float(row["y"])))
-    return _make(None, rows)
+        int(row["scan_index"]), int(row["person_id"]), float(row["x"]), float(row["y"]),
+        int(row["target"]) if row.get("target") not in (None, "") else -1))
+    gt = _make(None, [r[:4] for r in rows])
+    targets = {(r[0], r[1]) for r in rows if r[4] == 1}
+    if not rows or rows[0][4] < 0:
+        return gt
+    mark = np.array([(k, p) in targets for k, p in zip(gt.scan_index.tolist(), gt.person_id.tolist())], dtype=np.int64)
+    return GroundTruth(None, gt.scan_index, gt.person_id, gt.x, gt.y, mark)
 
 
 def read_ground_truth(path: str | Path, scan_topic: str | None = None, gt_topic: str | None = None) -> GroundTruth:

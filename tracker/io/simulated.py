@@ -17,12 +17,12 @@ from people_tracker.tracker.io.recording import ScanRecord
 DEFAULT_SCENE = "crossing"
 
 
-def _load(scenario: str, seed: int | None, people: int | None, duration: float | None):
+def _load(scenario: str, seed: int | None, people: int | None, duration: float | None, laser: str | None = None):
     try:
         spec = load_scenario(scenario)
         if duration is not None:
             spec = {**spec, "duration_s": duration}
-        return build_simulation(spec, seed=seed, crowd_count=people)
+        return build_simulation(spec, seed=seed, crowd_count=people, laser=laser)
     except ScenarioError as exc:
         raise InputError(str(exc)) from None
 
@@ -31,19 +31,19 @@ class SimulatedSource:
     """A scenario run in memory, read like a :class:`~people_tracker.tracker.io.recording.Recording`.
 
     The sensor pose of each scan is the odometry's (drift included) composed with the mount,
-    as a recording's would be.
+    as a recording's would be; None when the scene's recording has no odometry.
     """
 
     def __init__(self, scenario: str = DEFAULT_SCENE, seed: int | None = None, people: int | None = None,
-                 duration: float | None = None) -> None:
-        self.sim, self.scan_count = _load(scenario, seed, people, duration)
+                 duration: float | None = None, laser: str | None = None) -> None:
+        self.sim, self.scan_count = _load(scenario, seed, people, duration, laser)
         self.path = f"built-in scene '{scenario}'"
         self.topic = "/scan"
         self.laser_frame = self.sim.laser.frame_id
         self.n_beams = self.sim.laser.n_beams
         self.resolution = abs(self.sim.laser.angle_increment)
-        self.odometry = "simulated odometry + mount"
-        self.fixed_frame = "odom"
+        self.odometry = "simulated odometry + mount" if self.sim.has_odometry else None
+        self.fixed_frame = "odom" if self.sim.has_odometry else self.laser_frame
         self.truths = []  # the Truth of every scan produced so far
 
     def __enter__(self) -> "SimulatedSource":
@@ -57,17 +57,23 @@ class SimulatedSource:
             step = self.sim.step()
             self.truths.append(step.truth)
             bag_time = int(round(step.scan.stamp * 1e9))
+            if not self.sim.has_odometry:
+                yield ScanRecord(index, bag_time, step.scan, None, None, None)
+                continue
             last = step.odom_pose_last_beam @ self.sim.mount if step.odom_pose_last_beam is not None else None
             yield ScanRecord(index, bag_time, step.scan, step.odom_pose @ self.sim.mount, None, last)
 
 
 def simulate_to_bag(scenario: str, output: str | Path, seed: int | None = None, people: int | None = None,
-                    duration: float | None = None, fmt: str = "mcap", progress=None) -> tuple[Path, Path, int, int]:
+                    duration: float | None = None, fmt: str = "mcap", progress=None,
+                    laser: str | None = None) -> tuple[Path, Path, int, int]:
     """Render a scenario to a recording at ``output`` and its ground truth at ``output.gt.csv``.
 
     The recording holds ``/scan``, ``/odom`` (``odom`` → ``base_link``), ``/tf`` (the same)
-    and ``/tf_static`` (``base_link`` → laser). Ground truth has one row per person visible
-    by Leigh's rule per scan, in the sensor frame. Both files appear complete or not at all.
+    and ``/tf_static`` (``base_link`` → laser); no ``/odom`` and ``/tf`` when the scene says
+    ``odometry: false``. Ground truth has one row per person visible by Leigh's rule per scan,
+    in the sensor frame, ``target`` 1 for the person the robot follows. Both files appear
+    complete or not at all.
 
     Returns (bag path, ground truth path, scans, ground-truth rows).
     """
@@ -76,19 +82,19 @@ def simulate_to_bag(scenario: str, output: str | Path, seed: int | None = None, 
     if out.exists():
         raise InputError(f"output '{out}' exists already")
     check_writable(out)
-    sim, n_scans = _load(scenario, seed, people, duration)
+    sim, n_scans = _load(scenario, seed, people, duration, laser)
     parent = out.parent if str(out.parent) else Path(".")
     tmp_dir = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
     tmp_bag = tmp_dir / out.name
     rows = 0
     try:
         with atomic_output(gt_path) as gt, BagWriter(tmp_bag, fmt) as writer:
-            gt.write("scan_index,person_id,x,y\n")
+            gt.write("scan_index,person_id,x,y,target\n")
             frame = sim.laser.frame_id
             writer.write_tf(sim.t0, [("base_link", frame, sim.mount)], static=True)
             for index in range(n_scans):
                 step = sim.step()
-                for sample in step.odometry:
+                for sample in step.odometry if sim.has_odometry else ():
                     writer.write_odometry("/odom", sample.stamp, "odom", "base_link", sample.pose,
                                           (sample.v, 0.0, sample.omega))
                     writer.write_tf(sample.stamp, [("odom", "base_link", sample.pose)])
@@ -97,7 +103,7 @@ def simulate_to_bag(scenario: str, output: str | Path, seed: int | None = None, 
                 writer.write_scan("/scan", step.scan, bag_time=step.scan.stamp + sweep, scan_time=sim.laser.period)
                 tr = step.truth
                 for pid, (x, y) in zip(tr.person_id[tr.visible], tr.torso_sensor[tr.visible]):
-                    gt.write(f"{index},{pid},{x:.4f},{y:.4f}\n")
+                    gt.write(f"{index},{pid},{x:.4f},{y:.4f},{int(pid == sim.target_id)}\n")
                     rows += 1
                 if progress is not None:
                     progress(1)

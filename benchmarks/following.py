@@ -1,0 +1,99 @@
+"""Following figures on the simulated following scenes, every laser, several seeds.
+
+For each scene (``follow_outdoor``, ``follow_indoor_crowd``), each of its lasers and each
+seed, the default tracker runs with ``--follow auto`` over the simulated scans (in-process)
+and ``evaluate``'s following protocol scores it against the followed person (the simulator's
+truth): over all tracks, id switches, misses and MOTP (Leigh et al.'s figures); from the
+tracker's target, the share of the person's visible scans after the first lock with the
+target within 0.75 m of them, the scans with the target on someone or something else, the
+target changes and the time to the first lock. The last lines pool the runs.
+
+Usage::
+
+    python benchmarks/following.py                      # 2 scenes x 3 lasers x 5 seeds (about 10 min on 4 cores)
+    python benchmarks/following.py --scenes follow_outdoor --lasers narrow --seeds 1 --duration 60
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+from people_tracker.tracker.bench import scene_ground_truth
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.evaluation import TrackRows, evaluate
+from people_tracker.tracker.io.ground_truth import GroundTruth
+from people_tracker.tracker.io.simulated import SimulatedSource
+from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+
+SCENES = ("follow_outdoor", "follow_indoor_crowd")
+LASERS = ("narrow", "wide", "long_cw")
+SEEDS = (1, 2, 3, 4, 5)
+
+
+def run_following(scene: str, laser: str, seed: int, duration: float | None = None, config=None) -> dict:
+    """Evaluate's following figures for one run of ``scene`` with ``laser`` and ``seed``."""
+    source = SimulatedSource(scene, seed=seed, duration=duration, laser=laser)
+    tracker = PeopleTracker.from_config(config if config is not None else load_config(), follow="auto")
+    rows = []
+    for record in source.scans():
+        tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
+        for t, (x, y) in zip(tracks, tracks_in_sensor_frame(tracks, tracker.last.pose)):
+            rows.append((record.index, t.track_id, x, y, int(t.target), record.scan.stamp))
+    a = np.array(rows, dtype=float).reshape(-1, 6)
+    tr = TrackRows(a[:, 0].astype(np.int64), a[:, 1].astype(np.int64), a[:, 2], a[:, 3], a[:, 4].astype(np.int64), a[:, 5])
+    gt, _ = scene_ground_truth(source.truths)
+    gt = GroundTruth(gt.n_frames, gt.scan_index, gt.person_id, gt.x, gt.y)
+    r = evaluate(gt, tr, "following", target_person=source.sim.target_id)
+    return {"scene": scene, "laser": laser, "seed": seed, **r}
+
+
+def _job(args):
+    return run_following(*args)
+
+
+HEADER = (f"{'scene':<20} {'laser':<8} {'seed':>4} {'scans':>6} {'on %':>6} {'wrong':>5} {'chg':>4} {'lock s':>6} "
+          f"{'IDsw':>5} {'misses':>6} {'MOTP m':>6} {'MOTA %':>6}")
+
+
+def line(r: dict) -> str:
+    lock = "never" if r["first_lock_scan"] is None else f"{r['first_lock_s']:.2f}"
+    return (f"{r['scene']:<20} {r['laser']:<8} {r['seed']:>4} {r['target_person_scans']:>6} "
+            f"{100 * r['target_on_person']:>6.2f} {r['target_wrong_scans']:>5} {r['target_changes']:>4} {lock:>6} "
+            f"{r['id_switches']:>5} {r['misses']:>6} {r['motp_m']:>6.3f} {100 * r['mota']:>6.1f}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenes", nargs="+", default=list(SCENES))
+    ap.add_argument("--lasers", nargs="+", default=list(LASERS))
+    ap.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS))
+    ap.add_argument("--duration", type=float, help="seconds of each scene (default: the scene's 10 minutes)")
+    ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    args = ap.parse_args(argv)
+    jobs = [(s, laser, seed, args.duration) for s in args.scenes for laser in args.lasers for seed in args.seeds]
+    print(HEADER, flush=True)
+    results = []
+    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        for r in pool.map(_job, jobs):
+            results.append(r)
+            print(line(r), flush=True)
+    for scene in args.scenes:
+        rs = [r for r in results if r["scene"] == scene]
+        on = [r["target_on_person"] for r in rs]
+        locks = [r["first_lock_s"] for r in rs if r["first_lock_scan"] is not None]
+        print(f"{scene}: target on the person {100 * min(on):.2f} % at worst (mean {100 * np.mean(on):.2f} %), "
+              f"on someone or something else {sum(r['target_wrong_scans'] for r in rs)} scans, "
+              f"{sum(r['target_changes'] for r in rs)} target changes, first lock within "
+              f"{max(locks) if locks else float('nan'):.2f} s ({len(rs) - len(locks)} never), "
+              f"id switches {max(r['id_switches'] for r in rs)} at most, "
+              f"MOTP {max(r['motp_m'] for r in rs):.3f} m at most, over {len(rs)} runs")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
