@@ -104,6 +104,7 @@ class TracksConfig:
     init_speed_std_mps: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
     max_position_std_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1000.0))
     confirm_min_travel_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
+    confirm_leg_probability: float = field(metadata=_spec(lo=0.0, hi=1.01))
     max_tentative_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3600.0))
     still_after_s: float = field(metadata=_spec(lo=0.0, hi=3600.0))
     still_drift_mps: float = field(metadata=_spec(lo=0.0, hi=100.0))

@@ -44,7 +44,7 @@ class TargetSelector:
     """
 
     def __init__(self, mode: str | int | None, reacquire_s: float = 10.0, reacquire_m: float = 0.8,
-                 ahead_deg: float = 60.0, lock_range_m: float = 3.5, walk_mps: float = 0.7,
+                 ahead_deg: float = 60.0, lock_range_m: float = 3.5, walk_mps: float = 1.5,
                  coast_s: float = 0.5, max_reach_m: float = 4.0, steady_s: float = 1.5,
                  slide_m: float = 0.6) -> None:
         self.mode = mode

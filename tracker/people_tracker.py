@@ -539,10 +539,10 @@ class PeopleTracker:
                     t = self._retire(t)
                     sel.lost(stamp)
             if sel.lost_since is not None:
-                new_id = sel.reacquire(stamp, here(u for u in self._tracks if u.track_id != sel.target))
+                new_id = sel.reacquire(stamp, here(u for u in self._tracks if u.track_id != sel.target and u.reported))
                 if new_id is not None:
                     new = next(u for u in self._tracks if u.track_id == new_id)
-                    new.track_id, new.confirmed = sel.target, True  # the person keeps their id
+                    new.track_id = sel.target  # the person keeps their id
         reported = here(u for u in self._tracks if u.reported)
         target = sel.choose(reported)
         if target is not None and sel.expected(stamp) is None and target in reported:

@@ -27,7 +27,11 @@ class TrackParams:
         A track whose position uncertainty (1σ, largest axis) grows beyond this is deleted.
     confirm_min_travel_m : float
         A track born moving is confirmed only once it is this far from where it started:
-        people walk, clutter that the detector flags now and then does not.
+        people walk, clutter that the detector flags now and then does not ...
+    confirm_leg_probability : float
+        ... or once the leg model's probability at its place, averaged, reaches this:
+        someone a robot follows with nothing else in view (no odometry, no scan match)
+        stays put in the sensor frame, their legs swinging.
     max_tentative_s : float
         A track still tentative after this long is deleted.
     still_after_s : float
@@ -47,6 +51,7 @@ class TrackParams:
     init_speed_std_mps: float = 1.0
     max_position_std_m: float = 1.0
     confirm_min_travel_m: float = 0.4
+    confirm_leg_probability: float = 0.5
     max_tentative_s: float = 2.0
     still_after_s: float = 1.0
     still_drift_mps: float = 0.1
@@ -166,7 +171,8 @@ class TrackState:
                               self.still and self.place == "occupied", walking=self.moved and not self.still)
         if (not self.confirmed and self.existence.probability >= self.existence.params.confirm
                 and (self.born_standing or
-                     np.hypot(*(self.position - self.origin)) >= self.params.confirm_min_travel_m)):
+                     np.hypot(*(self.position - self.origin)) >= self.params.confirm_min_travel_m or
+                     self.existence.shape_p >= self.params.confirm_leg_probability)):
             self.confirmed = True
 
     @property

@@ -84,3 +84,39 @@ def test_run_without_input_runs_the_built_in_scene():
     proc = run_cli("run")
     assert proc.returncode == 0, proc.stderr
     assert "built-in scene 'crossing'" in proc.stdout and "200 read, 200 used" in proc.stdout
+
+
+def test_following_scene_without_odometry_names_its_target_and_scores_the_following(tmp_path):
+    out = tmp_path / "outdoor"
+    proc = run_cli("simulate", "follow_outdoor", "--laser", "narrow", "--output", str(out), "--duration", "20")
+    assert proc.returncode == 0, proc.stderr
+    assert "/odom" not in proc.stdout
+    gt = read_gt_csv(f"{out}.gt.csv")
+    assert gt.target is not None and set(gt.person_id[gt.target == 1].tolist()) == {1}
+    with Recording(out) as rec:
+        assert rec.fixed_frame is None  # no odometry in the recording
+        first = next(rec.scans()).scan
+    assert first.n_beams == 247 and abs(first.angle_increment - np.radians(0.35)) < 1e-4  # 86 deg at 0.35 deg
+    tracks = tmp_path / "tracks.csv"
+    proc = run_cli("run", str(out), "--follow", "auto", "--tracks", str(tracks))
+    assert proc.returncode == 0, proc.stderr
+    proc = run_cli("evaluate", str(tracks), "--ground-truth", f"{out}.gt.csv", "--protocol", "following")
+    assert proc.returncode == 0, proc.stderr
+    for line in ("followed person  1", "first lock", "target on the person", "target elsewhere", "target changes"):
+        assert line in proc.stdout, proc.stdout
+    # the ground truth names the person; another id must exist in it
+    proc = run_cli("evaluate", str(tracks), "--ground-truth", f"{out}.gt.csv", "--protocol", "following",
+                   "--target-person", "999")
+    assert proc.returncode == 2 and "999 is not in the ground truth" in proc.stderr
+
+
+def test_unknown_laser_and_a_target_person_without_following_are_one_line_errors(tmp_path):
+    proc = run_cli("simulate", "follow_outdoor", "--laser", "nope", "--output", str(tmp_path / "x"))
+    assert proc.returncode == 2 and "no laser 'nope'" in proc.stderr and "narrow" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and not (tmp_path / "x").exists()
+    gt = tmp_path / "gt.csv"
+    gt.write_text("scan_index,person_id,x,y\n0,1,1.0,0.0\n")
+    tr = tmp_path / "t.csv"
+    tr.write_text("scan_index,track_id,x,y\n0,1,1.0,0.0\n")
+    proc = run_cli("evaluate", str(tr), "--ground-truth", str(gt), "--target-person", "1")
+    assert proc.returncode == 2 and "--protocol following" in proc.stderr
