@@ -32,7 +32,7 @@ from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_senso
 
 SCENES = ("follow_outdoor", "follow_indoor_crowd")
 LASERS = ("narrow", "wide", "long_cw")
-SEEDS = (1, 2, 3, 4, 5)
+SEEDS = (11, 12, 13, 14, 15)  # held out: the following work was developed on seeds 1 and 2
 
 
 def run_following(scene: str, laser: str, seed: int, duration: float | None = None, config=None) -> dict:

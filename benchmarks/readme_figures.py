@@ -19,7 +19,7 @@ Each command runs in a scratch folder beside the repository (so ``../shared/data
 same folder it is from the repository's root, and ``benchmarks/``, ``demos/`` and
 ``configs/`` are linked into it), one block's commands in one folder, in order, and the
 block becomes a ``console`` fence with each ``$ command`` and its output (stdout and
-stderr as they came). ``#> tail N``, ``#> head N`` or ``#> grep TEXT`` after a command
+stderr as they came). ``#> tail N``, ``#> head N``, ``#> grep TEXT`` or ``#> grep -v TEXT`` after a command
 keeps only those lines of its output (shown after ``...`` where lines were left out).
 A command that fails stops the script with its output, and nothing is rewritten.
 """
@@ -52,7 +52,9 @@ def _filtered(output: str, rule: str | None) -> str:
         kept = lines[:int(arg)]
         return "\n".join(kept + (["..."] if len(kept) < len(lines) else []))
     if kind == "grep":
-        kept = [ln for ln in lines if arg in ln]
+        invert = arg.startswith("-v ")
+        text = arg[3:] if invert else arg
+        kept = [ln for ln in lines if (text in ln) != invert]
         return "\n".join((["..."] if len(kept) < len(lines) else []) + kept)
     raise SystemExit(f"readme_figures: unknown filter '#> {rule}'")
 

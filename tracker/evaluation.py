@@ -64,14 +64,16 @@ def frame_mismatches(gt: GroundTruth, tracks: TrackRows) -> list[str]:
     The ground truth's frames are its scans ``0..n-1`` (its last annotated scan when it
     does not say how many there are); the tracks' frames run from scan 0 (every message
     of the topic counts) to their last row. Said when the tracks go beyond the ground
-    truth, or when the two overlap on fewer than half of either's frames.
+    truth (by more than a quarter when it does not say how many frames it has: nobody may
+    be visible in the last scans), or when the two overlap on fewer than half of either's
+    frames.
     """
     if not len(tracks.scan_index):
         return []
     n_gt = gt.n_frames if gt.n_frames is not None else (int(gt.scan_index.max()) + 1 if len(gt.scan_index) else 0)
     n_tracks = int(tracks.scan_index.max()) + 1
     out = []
-    if n_tracks > n_gt:
+    if n_tracks > (n_gt if gt.n_frames is not None else 1.25 * n_gt):
         out.append(f"the tracks hold scan indices up to {n_tracks - 1}, beyond the ground truth's {n_gt} frames "
                    f"(0..{n_gt - 1}): are both from the same recording and topic?")
     overlap = min(n_gt, n_tracks)

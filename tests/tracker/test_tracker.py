@@ -226,18 +226,16 @@ STILL = {"laser": {"fov_deg": 270, "resolution_deg": 0.35, "rate_hz": 10, "range
          "world": {"room": [-3, -8, 12, 8]}, "robot": {"start": [0, 0, 0]}, "seed": 3}
 
 
-def test_a_person_standing_from_the_first_scan_is_not_reported_until_they_walk():
-    """Standing still from the first scan, never seen moving, on a place never seen empty:
-    nothing tells them from a coat stand with two legs. Once they walk, they are a person,
-    with one id."""
+def test_a_person_standing_from_the_first_scan_keeps_one_id_when_they_walk():
+    """Standing still from the first scan, then walking: one id throughout, nothing false,
+    and found by the time they have walked 0.8 s (their legs' shape and the flicker of
+    their readings find them earlier: see README, Limitations)."""
     spec = {**STILL, "duration_s": 10, "people": [{"id": 1, "path": [[3, 0.5], [3, 3.5]], "pauses": {0: 5.0},
                                                  "speed": 1.0}]}
     r, _, trk = run_scene(spec)
     assert r["false_positives"] == 0 and r["id_switches"] == 0, r
-    # not reported while they stand (5 s), found within 1.2 s of walking (a leg-shaped
-    # moving candidate starts their track at once; its existence needs them to walk)
-    assert 50 <= r["misses"] <= 50 + 12, r
-    assert r["matches"] == r["ground_truth"] - r["misses"]
+    assert r["misses"] <= 50 + 8, r  # 5 s standing, then found within 0.8 s of walking
+    assert r["matches"] >= 40
 
 
 def test_a_person_who_walks_in_and_stands_for_minutes_keeps_their_track():
