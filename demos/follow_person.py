@@ -4,8 +4,9 @@ The `follow_outdoor` scene: person 1 walks round a building and across an open f
 few trees and posts, turning sharply, stopping, while passers-by cross between them and the
 robot; sunlight adds spurious short readings. The robot has no odometry: each scan goes
 through the tracker alone (`--follow auto` locks onto the closest person ahead), and the
-robot's velocity command comes from where the tracker says the target is. The simulator's
-truth is used only to score the run, with `evaluate`'s following protocol.
+robot's velocity command comes from where the tracker says the target is (when the target is
+lost, from where it was last seen, for up to 10 s). The simulator's truth is used only to
+score the run, with `evaluate`'s following protocol.
 
     python demos/follow_person.py [--laser narrow|wide|long_cw] [--seed N] [--short] [--rrd FILE]
 
@@ -35,6 +36,7 @@ SCENE = "follow_outdoor"
 FOLLOW_DISTANCE_M = 1.0
 MAX_SPEED_MPS = 1.5
 MAX_TURN_RADPS = 1.5
+SEARCH_S = 10.0  # s: with the target lost, the robot drives on to where it was last seen for this long
 
 
 def steer(target_base: np.ndarray | None) -> Command:
@@ -68,6 +70,7 @@ def main(argv=None) -> int:
         from people_tracker.tracker.viz_rerun import RerunSink
         sink = RerunSink(args.rrd, name="follow-person")
     command = Command()
+    last_seen = None  # (stamp, world position) of the target when last reported
     gaps, rows, truths = [], [], []
     t0 = time.perf_counter()
     for i in range(n):
@@ -82,7 +85,16 @@ def main(argv=None) -> int:
         xy = tracks_in_sensor_frame(tracks, tracker.last.pose)
         rows += [(i, t.track_id, x, y, int(t.target), step.scan.stamp) for t, (x, y) in zip(tracks, xy)]
         target = [k for k, t in enumerate(tracks) if t.target]
-        command = steer(sim.mount.transform_points(xy[target[0]][None, :])[0]) if target else Command()
+        pose = tracker.last.pose  # the sensor in the tracker's world frame (from scan matching alone)
+        if target:
+            last_seen = (step.scan.stamp, np.array([tracks[target[0]].x, tracks[target[0]].y]))
+            command = steer(sim.mount.transform_points(xy[target[0]][None, :])[0])
+        elif last_seen is not None and step.scan.stamp - last_seen[0] <= SEARCH_S:
+            # lost: drive on to where they were last seen, then wait there
+            where = sim.mount.transform_points(pose.inverse().transform_points(last_seen[1][None, :]))[0]
+            command = steer(where) if np.hypot(*where) > FOLLOW_DISTANCE_M else Command()
+        else:
+            command = Command()
         k = list(truth.person_id).index(person) if person in truth.person_id else None
         if k is not None:
             gaps.append(math.hypot(truth.torso_world[k, 0] - truth.robot_pose.x, truth.torso_world[k, 1] - truth.robot_pose.y))

@@ -23,7 +23,7 @@ def test_follow_person_follows_without_odometry_and_prints_the_following_figures
     assert "following distance to person 1: median" in out and "no odometry" in out
     line = next(ln for ln in out.splitlines() if ln.startswith("target on person 1: "))
     on = float(line.split(": ")[1].split(" %")[0])
-    assert on >= 60.0 and "target changes: 0" in line, line  # the first minute, seed 1 (measured 72.8 %)
+    assert on >= 60.0 and "target changes: 0" in line, line  # the first minute, seed 1 (measured 74.6 %)
     assert "first lock: 0." in line  # within a second
     assert "over all tracks (Leigh et al.'s following figures): id switches" in out
     assert (tmp_path / "f.rrd").stat().st_size > 0
