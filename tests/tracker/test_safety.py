@@ -96,8 +96,10 @@ def test_ctrl_c_ends_a_run_with_130_and_no_files(tmp_path, extra):
     if extra:
         pytest.importorskip("rerun", reason="rerun is the [viz] extra")
     bag = data_file("leigh/general_tracking_moving_1.bag")
+    # a run started in the background by a shell inherits SIGINT ignored: a user's terminal does not
     proc = subprocess.Popen(cli_command() + ["run", str(bag), "--tracks", "t.csv", "--detections", "d.csv", *extra],
-                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     time.sleep(2.0)  # well into the 873 scans
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=20)
