@@ -63,12 +63,6 @@ class Alignment:
     tree: cKDTree | None = None
 
 
-def _unused(ref: ReferenceScan, mask: np.ndarray) -> None:
-    """Mark readings of the reference scan as no partner for matching."""
-    ref.usable = ref.usable & ~mask
-    ref.n_usable = int(ref.usable.sum())
-
-
 def _scale_motion(motion: Pose2D, fraction: float) -> Pose2D:
     return interpolate_pose(Pose2D(), motion, fraction)
 
@@ -92,8 +86,10 @@ class ScanAligner:
         """Leave these readings of the scan just aligned (its valid readings, in order) out
         of the next match: leg-shaped ones, say, that may walk with the robot (a person it
         follows stays put in the sensor frame, and would hold the match at no motion)."""
-        if self._ref is not None and len(mask) == len(self._ref.points) and mask.any():
-            _unused(self._ref, mask)
+        ref = self._ref
+        if ref is not None and len(mask) == len(ref.points) and mask.any():
+            ref.usable = ref.usable & ~mask
+            ref.n_usable = int(ref.usable.sum())
 
     def _exclusion(self, points: np.ndarray, rel: Pose2D, people_world: np.ndarray | None) -> np.ndarray | None:
         """Readings near the people, whose world positions are placed with the guess ``rel``."""
@@ -160,6 +156,5 @@ class ScanAligner:
             self._velocity = (rel, dt)
         tree = cKDTree(points)
         self._ref = ReferenceScan(points, p.icp, tree) if p.enabled else None
-        self._ref_points = points
         self._prev_stamp, self._prev_odom = scan.stamp, odom
         return Alignment(scan, self._world, result, kind, tree)

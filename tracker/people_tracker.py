@@ -521,16 +521,17 @@ class PeopleTracker:
 
         if sel.target is not None:
             t = next((u for u in self._tracks if u.track_id == sel.target), None)
-            if t is not None and t.reported and not sel.within_reach(stamp, here([t])[t.track_id]):
+            q = here([t])[t.track_id] if t is not None else None
+            if t is not None and t.reported and not sel.within_reach(stamp, q):
                 t = self._retire(t)  # it is somewhere the person cannot be: on someone or something else
-            if t is not None and t.reported and t.updated_now and sel.slid(here([t])[t.track_id]):
+            if t is not None and t.reported and t.updated_now and sel.slid(q):
                 # moved off where the person has been while another track is there: it slid onto a passer-by
                 if sel.only_one_near(stamp, here(u for u in self._tracks if u is not t and u.updated_now),
                                      steady=True) is not None:
                     t = self._retire(t)
                     sel.lost(stamp)
             if t is not None and t.reported and t.updated_now:
-                sel.seen(stamp, here([t])[t.track_id])
+                sel.seen(stamp, q)
             elif t is None or not t.reported:
                 sel.lost(stamp)
             elif stamp - t.last_update >= sel.coast_s:
