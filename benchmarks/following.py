@@ -44,8 +44,7 @@ def run_following(scene: str, laser: str, seed: int, duration: float | None = No
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
         for t, (x, y) in zip(tracks, tracks_in_sensor_frame(tracks, tracker.last.pose)):
             rows.append((record.index, t.track_id, x, y, int(t.target), record.scan.stamp))
-    a = np.array(rows, dtype=float).reshape(-1, 6)
-    tr = TrackRows(a[:, 0].astype(np.int64), a[:, 1].astype(np.int64), a[:, 2], a[:, 3], a[:, 4].astype(np.int64), a[:, 5])
+    tr = TrackRows.of(rows)
     gt, _ = scene_ground_truth(source.truths)
     gt = GroundTruth(gt.n_frames, gt.scan_index, gt.person_id, gt.x, gt.y)
     r = evaluate(gt, tr, "following", target_person=source.sim.target_id)

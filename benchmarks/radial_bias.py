@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from people_tracker.tracker.bench import _run, _track_rows, scene_ground_truth
+from people_tracker.tracker.bench import _run, scene_ground_truth
 from people_tracker.tracker.config import config_from_dict
-from people_tracker.tracker.evaluation import evaluate
+from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.io.ground_truth import read_bag_ground_truth
 from people_tracker.tracker.io.recording import Recording
 from people_tracker.tracker.io.simulated import SimulatedSource
@@ -60,13 +60,13 @@ def main() -> int:
         if RECORDING.exists():
             with Recording(RECORDING, "/scan", config.odometry) as rec:
                 rows = _run(rec, config, timed_read=False, limit=None)[0]
-            gt, tracks = read_bag_ground_truth(RECORDING, "/scan"), _track_rows(rows)
+            gt, tracks = read_bag_ground_truth(RECORDING, "/scan"), TrackRows.of(rows)
             print(line(RECORDING.name, variant, radial_offsets(gt, tracks), evaluate(gt, tracks)["motp_m"]), flush=True)
         for name, laser, duration in SCENES:
             source = SimulatedSource(name, laser=laser, duration=duration)
             rows = _run(source, config, timed_read=False, limit=None)[0]
             gt, hidden = scene_ground_truth(source.truths)
-            tracks = _track_rows(rows)
+            tracks = TrackRows.of(rows)
             label = f"simulated {name}" + (f" ({laser}, {duration:g} s)" if laser else "")
             print(line(label, variant, radial_offsets(gt, tracks), evaluate(gt, tracks, hidden=hidden)["motp_m"]),
                   flush=True)

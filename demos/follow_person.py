@@ -100,9 +100,7 @@ def main(argv=None) -> int:
             gaps.append(math.hypot(truth.torso_world[k, 0] - truth.robot_pose.x, truth.torso_world[k, 1] - truth.robot_pose.y))
     if sink is not None:
         sink.close()
-    a = np.array(rows, dtype=float).reshape(-1, 6)
-    tr = TrackRows(a[:, 0].astype(np.int64), a[:, 1].astype(np.int64), a[:, 2], a[:, 3], a[:, 4].astype(np.int64), a[:, 5])
-    r = evaluate(scene_ground_truth(truths)[0], tr, "following", target_person=person)
+    r = evaluate(scene_ground_truth(truths)[0], TrackRows.of(rows), "following", target_person=person)
     g = np.array(gaps)
     print(f"follow_person: {SCENE}, laser {args.laser}, seed {args.seed}: {n} scans ({n / sim.laser.rate_hz:.0f} s) "
           f"in {time.perf_counter() - t0:.1f} s, no odometry")

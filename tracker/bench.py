@@ -81,11 +81,6 @@ def _run(source, config: Config, timed_read: bool, limit: int | None):
     return rows, times, ids, span, lasting
 
 
-def _track_rows(rows) -> TrackRows:
-    a = np.array(rows, dtype=float).reshape(-1, 4)
-    return TrackRows(a[:, 0].astype(np.int64), a[:, 1].astype(np.int64), a[:, 2], a[:, 3])
-
-
 def bench_recording(path: Path, topic: str, config: Config, limit: int | None) -> list[Row]:
     """The recording's row; for an annotated one, also its score in Leigh et al.'s bearing window."""
     with Recording(path, topic, config.odometry) as rec:
@@ -96,10 +91,10 @@ def bench_recording(path: Path, topic: str, config: Config, limit: int | None) -
         if limit is not None:
             keep = gt.scan_index < limit
             gt = GroundTruth(min(gt.n_frames, limit), gt.scan_index[keep], gt.person_id[keep], gt.x[keep], gt.y[keep])
-        row.result = evaluate(gt, _track_rows(rows))
+        row.result = evaluate(gt, TrackRows.of(rows))
         lo, hi = LEIGH_WINDOW_DEG
         window = Row(f"  same, bearings {lo:g}..{hi:g} deg (Leigh's protocol)", len(times), [],
-                     evaluate(gt, _track_rows(rows), bearing_window_deg=LEIGH_WINDOW_DEG))
+                     evaluate(gt, TrackRows.of(rows), bearing_window_deg=LEIGH_WINDOW_DEG))
         return [row, window]
     row.tracks_per_min = len(ids) / (span / 60.0) if span > 0 else float("nan")
     return [row]
@@ -120,7 +115,7 @@ def bench_scene(name: str, config: Config, duration: float | None) -> Row:
     source = SimulatedSource(name, duration=duration)
     rows, times, ids, span, _ = _run(source, config, timed_read=False, limit=None)
     gt, hidden = scene_ground_truth(source.truths)
-    return Row(f"simulated {name}", len(times), times, evaluate(gt, _track_rows(rows), hidden=hidden))
+    return Row(f"simulated {name}", len(times), times, evaluate(gt, TrackRows.of(rows), hidden=hidden))
 
 
 def recordings(data: Path) -> list[tuple[Path, str]]:

@@ -423,17 +423,12 @@ def _cmd_simulate(args) -> int:
         raise InputError("--duration must be positive")
     t0 = time.perf_counter()
     with _progress(None, args.quiet) as bar:
-        bag, gt, n, rows = simulate_to_bag(args.scenario, args.output, args.seed, args.people, args.duration,
+        bag, gt, n, rows, odometry = simulate_to_bag(args.scenario, args.output, args.seed, args.people, args.duration,
                                            args.format, progress=bar.update, laser=args.laser)
-    topics = "/scan, /odom, /tf, /tf_static" if _scene_has_odometry(args.scenario) else "/scan, /tf_static"
+    topics = "/scan, /odom, /tf, /tf_static" if odometry else "/scan, /tf_static"
     print(f"wrote {bag} ({n} scans on {topics}; {args.format}) and {gt} "
           f"({rows} visible people) in {time.perf_counter() - t0:.1f} s")
     return 0
-
-
-def _scene_has_odometry(scenario: str) -> bool:
-    from people_tracker.models.scenario import load_scenario
-    return bool((load_scenario(scenario).get("robot") or {}).get("odometry", True))
 
 
 def _cmd_bench(args) -> int:

@@ -57,6 +57,16 @@ class TrackRows:
     def __len__(self) -> int:
         return int(self.scan_index.shape[0])
 
+    @classmethod
+    def of(cls, rows) -> "TrackRows":
+        """From rows ``(scan_index, track_id, x, y)``, or ``(…, target, stamp)`` with the
+        followed person's flag and the scan's stamp (s)."""
+        a = np.array(rows, dtype=float)
+        a = a.reshape(-1, a.shape[1] if a.ndim == 2 else 4)
+        full = a.shape[1] >= 6
+        return cls(a[:, 0].astype(np.int64), a[:, 1].astype(np.int64), a[:, 2], a[:, 3],
+                   a[:, 4].astype(np.int64) if full else None, a[:, 5] if full else None)
+
 
 def frame_mismatches(gt: GroundTruth, tracks: TrackRows) -> list[str]:
     """Reasons to doubt that ``tracks`` and ``gt`` come from one recording, one line each.
@@ -193,7 +203,7 @@ def target_continuity(person: GroundTruth, others: GroundTruth, tracks: TrackRow
             wrong += 1
     out["target_wrong_scans"] = wrong
     if tracks.stamp is not None and len(np.unique(tracks.scan_index)) >= 2:
-        slope, offset = np.polyfit(tracks.scan_index.astype(float), tracks.stamp, 1)
+        slope = np.polyfit(tracks.scan_index.astype(float), tracks.stamp, 1)[0]  # s per scan
         out["first_lock_s"] = float(slope * (lock - int(p_scan[0])))
     return out
 

@@ -66,7 +66,7 @@ class SimulatedSource:
 
 def simulate_to_bag(scenario: str, output: str | Path, seed: int | None = None, people: int | None = None,
                     duration: float | None = None, fmt: str = "mcap", progress=None,
-                    laser: str | None = None) -> tuple[Path, Path, int, int]:
+                    laser: str | None = None) -> tuple[Path, Path, int, int, bool]:
     """Render a scenario to a recording at ``output`` and its ground truth at ``output.gt.csv``.
 
     The recording holds ``/scan``, ``/odom`` (``odom`` → ``base_link``), ``/tf`` (the same)
@@ -75,7 +75,7 @@ def simulate_to_bag(scenario: str, output: str | Path, seed: int | None = None, 
     in the sensor frame, ``target`` 1 for the person the robot follows. Both files appear
     complete or not at all.
 
-    Returns (bag path, ground truth path, scans, ground-truth rows).
+    Returns (bag path, ground truth path, scans, ground-truth rows, whether odometry was written).
     """
     out = Path(output)
     gt_path = Path(f"{out}.gt.csv")
@@ -114,4 +114,4 @@ def simulate_to_bag(scenario: str, output: str | Path, seed: int | None = None, 
         raise
     finally:
         shutil.rmtree(tmp_dir, ignore_errors=True)
-    return out, gt_path, n_scans, rows
+    return out, gt_path, n_scans, rows, sim.has_odometry
