@@ -352,7 +352,8 @@ class PeopleTracker:
         """A person-sized group of this scan's readings near each place (world frame), or None."""
         d = self.detector.params
         return static_support(places, world, scan, d.k_segment, d.segment_floor_m, self.assoc.support_radius_m,
-                              self.pairing.max_person_size_m, self.assoc.support_min_points)
+                              self.pairing.max_person_size_m, self.assoc.support_min_points,
+                              self.pairing.max_leg_radius_m)
 
     def _clear_of_tracks(self, xy: np.ndarray) -> np.ndarray:
         """Whether each place (world frame) is at least ``spawn_exclusion_m`` from every track."""

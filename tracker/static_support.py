@@ -17,11 +17,12 @@ from people_tracker.detection.segments import split_runs
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
+from people_tracker.tracker.pairing import leg_centres
 
 
 def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_segment: float,
                    segment_floor_m: float, radius_m: float, max_size_m: float,
-                   min_points: int) -> list[np.ndarray | None]:
+                   min_points: int, max_leg_radius_m: float = 0.0) -> list[np.ndarray | None]:
     """For each predicted position (world frame, m), a supporting position or None.
 
     Parameters
@@ -38,6 +39,11 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         Largest extent (bounding-box diagonal) of a person, metres.
     min_points : int
         Fewest readings that support a person.
+    max_leg_radius_m : float
+        The position is where the legs' centres are, behind the readings (as
+        :func:`~people_tracker.tracker.pairing.leg_centres` steps back a leg, taking half the
+        group's extent as the radius, at most this), so a track updated in turn by leg
+        pairs and by static support is not pulled back and forth; 0: the readings' mean.
     """
     out: list[np.ndarray | None] = [None] * len(predictions_world)
     if len(predictions_world) == 0 or scan.n_valid == 0:
@@ -62,5 +68,8 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         p = pts[members]
         if len(p) < min_points or np.hypot(*np.ptp(p, axis=0)) > max_size_m:
             continue
-        out[t] = pose.transform_points(p.mean(axis=0, keepdims=True))[0]
+        centre = p.mean(axis=0, keepdims=True)
+        if max_leg_radius_m > 0:
+            centre = leg_centres(centre, np.hypot(*np.ptp(p, axis=0))[None], max_leg_radius_m)
+        out[t] = pose.transform_points(centre)[0]
     return out
