@@ -3,7 +3,9 @@
 The target model lives in the sensor frame: a robot that follows someone keeps them at much
 the same place in front of it, whatever it knows of its own motion (without odometry, in a
 scene that gives scan matching little to hold on to, the world frame drifts and jumps; the
-person's place relative to the sensor does not). When the target's track breaks off, or
+person's place relative to the sensor does not). Only the sensor's turn, which scan matching
+measures well even there, is taken out when the person is looked for after a gap: a robot
+turning after its person swings them across its view. When the target's track breaks off, or
 coasts while a fresh track appears where the person should be, the person's id goes to the
 track at that place — when exactly one is there; when more than one could be them, the
 person is reported lost rather than swapped for someone else.
@@ -56,6 +58,8 @@ class TargetSelector:
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
         self._v = np.zeros(2)  # ... its rate of change (m/s) ...
         self._t: float | None = None  # ... and when their track was last updated (s)
+        self._yaw = 0.0  # the sensor's heading (world frame, rad) when the person was last seen ...
+        self.yaw = 0.0  # ... and now (the tracker sets it every scan)
         self.lost_since: float | None = None  # when the target's track broke off, while it is missing
         self.events: list[str] = []
 
@@ -72,7 +76,7 @@ class TargetSelector:
             self.steady = self.steady + a * (q - self.steady)
         else:
             self.steady = q.copy()
-        self._q, self._t = q.copy(), stamp
+        self._q, self._t, self._yaw = q.copy(), stamp, self.yaw
         self.lost_since = None
 
     def lost(self, stamp: float) -> None:
@@ -86,7 +90,13 @@ class TargetSelector:
         if self._q is None or self._t is None:
             return None
         gap = max(stamp - self._t, 0.0)
-        return self._q + self._v * min(gap, 1.0), min(self._reacquire_m + self._walk * gap, self._max_reach)
+        q = self._q + self._v * min(gap, 1.0)
+        # the sensor turned since (its heading from scan matching holds well even where its
+        # place drifts): the person's bearing turns back by as much
+        turn = self.yaw - self._yaw
+        c, s = math.cos(turn), math.sin(turn)
+        return np.array([c * q[0] + s * q[1], -s * q[0] + c * q[1]]), \
+            min(self._reacquire_m + self._walk * gap, self._max_reach)
 
     def within_reach(self, stamp: float, q: np.ndarray) -> bool:
         """Whether the person could be at ``q`` (sensor frame, m) now."""

@@ -516,6 +516,7 @@ class PeopleTracker:
         if sel is None:
             return None
         inv = world.inverse()
+        sel.yaw = world.yaw
 
         def here(tracks) -> dict[int, np.ndarray]:  # id -> place in the sensor frame (m)
             return {u.track_id: inv.transform_points(u.position[None])[0] for u in tracks}
