@@ -90,13 +90,17 @@ class TargetSelector:
         if self._q is None or self._t is None:
             return None
         gap = max(stamp - self._t, 0.0)
-        q = self._q + self._v * min(gap, 1.0)
-        # the sensor turned since (its heading from scan matching holds well even where its
-        # place drifts): the person's bearing turns back by as much
+        return self._turn(self._q + self._v * min(gap, 1.0)), min(self._reacquire_m + self._walk * gap,
+                                                                  self._max_reach)
+
+    def _turn(self, q: np.ndarray) -> np.ndarray:
+        """A place in the sensor frame when the person was last seen, in the sensor frame now.
+
+        Only the sensor's turn since is taken out (its heading from scan matching holds well
+        even where its place drifts): the person's bearing turns back by as much."""
         turn = self.yaw - self._yaw
         c, s = math.cos(turn), math.sin(turn)
-        return np.array([c * q[0] + s * q[1], -s * q[0] + c * q[1]]), \
-            min(self._reacquire_m + self._walk * gap, self._max_reach)
+        return np.array([c * q[0] + s * q[1], -s * q[0] + c * q[1]])
 
     def within_reach(self, stamp: float, q: np.ndarray) -> bool:
         """Whether the person could be at ``q`` (sensor frame, m) now."""
