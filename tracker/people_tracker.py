@@ -90,6 +90,9 @@ class StepResult:
     leg_scores: np.ndarray | None = None  # ... and the leg model's probability for each
 
 
+PASSING_MPS = 0.5  # m/s: a track this fast passing close by someone standing is a passer-by, not them twice
+
+
 class PeopleTracker:
     """Detector → leg pairing → Kalman tracks with association, lifecycle and following.
 
@@ -118,6 +121,7 @@ class PeopleTracker:
         self._stood: list[list] = []  # where people who walked in stand still: [xy (m), last stamp (s), id, l_dyn]
         self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
         self._leg_scores = np.zeros(0)  # ... and their leg probabilities
+        self._explained: np.ndarray | None = None  # this scan's readings taken by moving candidates given to tracks
         self._tracks: list[TrackState] = []
         self._next_id = 1
         self.last: StepResult | None = None
@@ -167,6 +171,7 @@ class PeopleTracker:
         for ti, ci in matched:  # 5. update the matched tracks
             c = candidates[ci]
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
+        self._explained = self._explained_readings(detection, [candidates[ci] for _, ci in matched], scan.n_beams)
         legs = leg_candidates(scan)  # 6. every leg candidate and its probability, by shape alone
         leg_scores = self.leg_model.probability(legs.features)
         self._unmatchable_legs(scan, legs, leg_scores)
@@ -186,6 +191,16 @@ class PeopleTracker:
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.reported]
         self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing, legs, leg_scores)
         return reported
+
+    @staticmethod
+    def _explained_readings(detection: Detection, used: list[PersonCandidate], n_beams: int) -> np.ndarray:
+        """The readings (per beam) of the moving objects that candidates given to tracks were made of."""
+        mask = np.zeros(n_beams, dtype=bool)
+        ids = {i for c in used for i in c.object_ids}
+        for o in detection.objects:
+            if o.object_id in ids:
+                mask[o.beams] = True
+        return mask
 
     def _unmatchable_legs(self, scan: Scan, legs: LegCandidates, scores: np.ndarray) -> None:
         """Leg-shaped readings take no part in matching the next scan: legs walk."""
@@ -353,7 +368,7 @@ class PeopleTracker:
         d = self.detector.params
         return static_support(places, world, scan, d.k_segment, d.segment_floor_m, self.assoc.support_radius_m,
                               self.pairing.max_person_size_m, self.assoc.support_min_points,
-                              self.pairing.max_leg_radius_m)
+                              self.pairing.max_leg_radius_m, self._explained)
 
     def _clear_of_tracks(self, xy: np.ndarray) -> np.ndarray:
         """Whether each place (world frame) is at least ``spawn_exclusion_m`` from every track."""
@@ -387,6 +402,9 @@ class PeopleTracker:
         if not p.enabled:
             return []
         keep = scores >= p.min_leg_probability
+        if self._explained is not None and keep.any():  # a passer-by's leg pairs with nobody standing
+            taken = np.concatenate([[0], np.cumsum(self._explained[scan.valid])])
+            keep &= taken[legs.stop] == taken[legs.start]
         xy = legs.xy[keep]
         if self.pairing.max_leg_radius_m > 0 and len(xy):
             pts = scan.valid_points
@@ -469,8 +487,10 @@ class PeopleTracker:
         """Indices of tracks that slid onto a person standing still who has a track already.
 
         Two people's torsos are never closer than ``tracks.min_person_separation_m``; when a
-        track comes that close to one standing still, it is the same person twice: the one
-        that stood there longer keeps the place (with both still, the older track)."""
+        track born beside one standing still comes that close, it is the same person twice:
+        the one that stood there longer keeps the place (with both still, the older track).
+        A track that started farther away than ``association.recover_radius_m`` and walks on
+        (updated, at ``PASSING_MPS`` or faster) is someone passing close by, and stays."""
         sep = self.track_params.min_person_separation_m
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
         if len(idx) < 2 or sep <= 0:
@@ -483,7 +503,11 @@ class PeopleTracker:
             if not (ta.still or tb.still) or idx[a] in out or idx[b] in out:
                 continue
             if ta.still != tb.still:
-                out.add(idx[b] if ta.still else idx[a])
+                walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
+                passing = (np.hypot(*(walker.origin - stander.position)) > self.assoc.recover_radius_m
+                           and walker.updated_now and np.hypot(*walker.kf.x[1::2]) >= PASSING_MPS)
+                if not passing:  # born beside them (their own leg's track), or sliding onto them
+                    out.add(k)
             else:
                 out.add(idx[b] if ta.born <= tb.born else idx[a])
         return out

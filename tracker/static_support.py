@@ -22,7 +22,8 @@ from people_tracker.tracker.pairing import leg_centres
 
 def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_segment: float,
                    segment_floor_m: float, radius_m: float, max_size_m: float,
-                   min_points: int, max_leg_radius_m: float = 0.0) -> list[np.ndarray | None]:
+                   min_points: int, max_leg_radius_m: float = 0.0,
+                   explained: np.ndarray | None = None) -> list[np.ndarray | None]:
     """For each predicted position (world frame, m), a supporting position or None.
 
     Parameters
@@ -44,6 +45,9 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         :func:`~people_tracker.tracker.pairing.leg_centres` steps back a leg, taking half the
         group's extent as the radius, at most this), so a track updated in turn by leg
         pairs and by static support is not pulled back and forth; 0: the readings' mean.
+    explained : ndarray of bool, shape (n_beams,), optional
+        Readings another person's moving candidate took this scan: they support nobody
+        else (a passer-by's leg beside someone standing must not pull them along).
     """
     out: list[np.ndarray | None] = [None] * len(predictions_world)
     if len(predictions_world) == 0 or scan.n_valid == 0:
@@ -57,6 +61,8 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         seg_of[r.start:r.stop] = i
     pred_sensor = pose.inverse().transform_points(predictions_world)
     d = pairwise_distances(pred_sensor, pts)
+    free = np.ones(len(valid), dtype=bool) if explained is None else ~explained[valid]
+    d[:, ~free] = np.inf
     chosen = np.zeros(len(runs), dtype=bool)
     for t in range(len(pred_sensor)):
         near = seg_of[d[t] <= radius_m]
@@ -64,7 +70,7 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
             continue
         chosen[:] = False
         chosen[near] = True
-        members = chosen[seg_of]
+        members = chosen[seg_of] & free
         p = pts[members]
         if len(p) < min_points or np.hypot(*np.ptp(p, axis=0)) > max_size_m:
             continue
