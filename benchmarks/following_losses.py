@@ -1,0 +1,84 @@
+"""Where the followed person's target goes when it is not on them, scan by scan.
+
+Usage::
+
+    python benchmarks/following_losses.py [--scene follow_indoor_crowd] [--laser wide] [--seed 2] [--duration S]
+
+Runs the default tracker with ``--follow auto`` on one simulated following run and sorts
+every scan where the person is visible, after the first lock, into: the target is on them
+(within 0.75 m, sensor frame); on someone or something else; no target while a reported
+track is on them (the tracker has them, the target model gave the id to no one: with the
+person lost, how many reported tracks lay within the reach where they were looked for);
+no target while only an unreported track is on them; no target and no track near them.
+The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections import Counter
+
+import numpy as np
+
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.io.simulated import SimulatedSource
+from people_tracker.tracker.people_tracker import PeopleTracker
+
+NEAR_M = 0.75  # m: the following protocol's match distance
+
+
+def classify(scene: str, laser: str, seed: int, duration: float | None) -> Counter:
+    source = SimulatedSource(scene, seed=seed, duration=duration, laser=laser)
+    tracker = PeopleTracker.from_config(load_config(), follow="auto")
+    person, sel = source.sim.target_id, tracker.selector
+    out: Counter = Counter()
+    locked = False
+    for record in source.scans():
+        tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
+        truth = source.truths[record.index]
+        k = np.flatnonzero((truth.person_id == person) & truth.visible)
+        locked |= any(t.target for t in tracks)
+        if not len(k) or not locked:
+            continue
+        inv = tracker.last.pose.inverse()
+        here = {t.track_id: inv.transform_points(np.array([[t.x, t.y]]))[0] for t in tracks}
+        dist = {tid: float(np.hypot(*(q - truth.torso_sensor[k[0]]))) for tid, q in here.items()}
+        target = next((t.track_id for t in tracks if t.target), None)
+        if target is not None:
+            out["target on the person" if dist[target] <= NEAR_M else "target on someone or something else"] += 1
+            continue
+        if any(d <= NEAR_M for d in dist.values()):
+            exp = sel.expected(record.scan.stamp)
+            if sel.target is None or sel.lost_since is None or exp is None:
+                why = "no person being looked for"
+            else:
+                near = sum(float(np.hypot(*(q - exp[0]))) <= exp[1] for q in here.values())
+                why = "they were not within reach" if near == 0 else \
+                    f"{min(near, 3)}{'+' if near >= 3 else ''} reported tracks within reach"
+            out[f"no target, a reported track on them: {why}"] += 1
+        elif any(float(np.hypot(*(inv.transform_points(u.position[None])[0] - truth.torso_sensor[k[0]]))) <= NEAR_M
+                 for u in tracker._tracks):
+            out["no target, only an unreported track on them"] += 1
+        else:
+            out["no target, no track near them"] += 1
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scene", default="follow_indoor_crowd")
+    ap.add_argument("--laser", default="wide")
+    ap.add_argument("--seed", type=int, default=2)
+    ap.add_argument("--duration", type=float, help="seconds (default: the scene's 10 minutes)")
+    args = ap.parse_args(argv)
+    counts = classify(args.scene, args.laser, args.seed, args.duration)
+    total = sum(counts.values())
+    print(f"{args.scene}, laser {args.laser}, seed {args.seed}: {total} scans with the person visible after the first lock")
+    for what, n in sorted(counts.items(), key=lambda kv: -kv[1]):
+        print(f"{100 * n / max(total, 1):6.1f} %  {n:6d}  {what}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
