@@ -1,0 +1,72 @@
+"""A passer-by beside someone standing, and a followed person looked for after the robot turns."""
+
+import math
+
+import numpy as np
+
+from people_tracker.models.pose import Pose2D
+from people_tracker.models.scenario import build_simulation
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.following import TargetSelector
+from people_tracker.tracker.people_tracker import PeopleTracker
+from people_tracker.tracker.static_support import static_support
+
+LASER = {"fov_deg": 270, "resolution_deg": 0.35, "rate_hz": 10, "range_max": 20, "noise_std": 0.0}
+
+
+def _scan(pillars):
+    sim, _ = build_simulation({"duration_s": 1, "laser": LASER, "world": {"room": [-1, -6, 6, 6], "pillars": pillars}})
+    return sim.step().scan
+
+
+def test_readings_another_track_took_support_nobody_else():
+    # someone standing (two legs at y = 0 and -0.2) and a passer-by's leg 0.3 m beside them
+    scan = _scan([[3.0, 0.0, 0.06], [3.0, -0.2, 0.06], [3.0, 0.3, 0.06]])
+    place = np.array([[3.0, -0.1]])
+    both = static_support(place, Pose2D(), scan, 12.0, 0.06, 0.35, 0.8, 3)[0]
+    passer = np.zeros(scan.n_beams, dtype=bool)
+    angles = scan.angle_min + scan.angle_increment * np.arange(scan.n_beams)
+    passer[np.abs(angles - math.atan2(0.3, 3.0)) < 0.03] = True  # the passer's leg's beams
+    alone = static_support(place, Pose2D(), scan, 12.0, 0.06, 0.35, 0.8, 3, explained=passer)[0]
+    assert both is not None and alone is not None
+    assert both[1] > -0.02  # pulled towards the passer-by
+    assert abs(alone[1] + 0.1) < 0.03  # between the standing person's own legs
+
+
+def test_static_support_steps_back_to_the_leg_centres():
+    scan = _scan([[3.0, 0.0, 0.06], [3.0, -0.2, 0.06]])
+    place = np.array([[3.0, -0.1]])
+    mean = static_support(place, Pose2D(), scan, 12.0, 0.06, 0.35, 0.8, 3)[0]
+    centre = static_support(place, Pose2D(), scan, 12.0, 0.06, 0.35, 0.8, 3, max_leg_radius_m=0.08)[0]
+    assert mean[0] < 2.97  # the readings lie on the legs' near side
+    assert abs(centre[0] - 3.0) < 0.03  # as far as the legs' centres
+
+
+def test_a_person_walking_past_someone_standing_keeps_their_own_track():
+    # B stands; A walks past 0.45 m in front of them, from far away, and on
+    spec = {"duration_s": 16.0, "laser": LASER, "world": {"room": [-1, -6, 9, 6]},
+            "people": [{"id": 1, "path": [[4.0, -3.0], [4.0, 0.0], [4.0, 0.5]], "speed": 1.0, "pauses": {1: 60.0}},
+                       {"id": 2, "path": [[3.55, -5.0], [3.55, 5.0]], "speed": 1.2, "start_s": 8.0}]}
+    sim, n = build_simulation(spec)
+    tracker = PeopleTracker.from_config(load_config())
+    ids: dict[int, set] = {1: set(), 2: set()}
+    for _ in range(n):
+        st = sim.step()
+        tracks = tracker.step(st.scan, st.odom_pose @ sim.mount)
+        tr = st.truth
+        for p, xy, vis in zip(tr.person_id, tr.torso_world, tr.visible):
+            d = [np.hypot(t.x - xy[0], t.y - xy[1]) for t in tracks]
+            if vis and d and min(d) < 0.4:  # the track nearest them
+                ids[int(p)].add(tracks[int(np.argmin(d))].track_id)
+    assert len(ids[2]) == 1, ids  # the walker kept one id past the standing person
+    assert ids[1].isdisjoint(ids[2]), ids
+
+
+def test_the_lost_person_is_looked_for_where_the_sensor_turned_them():
+    sel = TargetSelector("auto")
+    sel.yaw = 0.0
+    sel.seen(0.0, np.array([2.0, 0.0]))  # straight ahead
+    sel.yaw = math.pi / 2  # the robot turned left a quarter turn
+    where, reach = sel.expected(0.5)
+    assert np.allclose(where, [0.0, -2.0], atol=1e-9)  # now on its right
+    assert sel.within_reach(0.5, np.array([0.2, -2.1])) and not sel.within_reach(0.5, np.array([2.0, 0.0]))
