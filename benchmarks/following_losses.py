@@ -23,7 +23,7 @@ import numpy as np
 
 from people_tracker.tracker.config import load_config
 from people_tracker.tracker.io.simulated import SimulatedSource
-from people_tracker.tracker.people_tracker import PeopleTracker
+from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 
 NEAR_M = 0.75  # m: the following protocol's match distance
 
@@ -41,8 +41,7 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
         locked |= any(t.target for t in tracks)
         if not len(k) or not locked:
             continue
-        inv = tracker.last.pose.inverse()
-        here = {t.track_id: inv.transform_points(np.array([[t.x, t.y]]))[0] for t in tracks}
+        here = dict(zip((t.track_id for t in tracks), tracks_in_sensor_frame(tracks, tracker.last.pose)))
         dist = {tid: float(np.hypot(*(q - truth.torso_sensor[k[0]]))) for tid, q in here.items()}
         target = next((t.track_id for t in tracks if t.target), None)
         if target is not None:
@@ -57,8 +56,8 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
                 why = "they were not within reach" if near == 0 else \
                     f"{min(near, 3)}{'+' if near >= 3 else ''} reported tracks within reach"
             out[f"no target, a reported track on them: {why}"] += 1
-        elif any(float(np.hypot(*(inv.transform_points(u.position[None])[0] - truth.torso_sensor[k[0]]))) <= NEAR_M
-                 for u in tracker._tracks):
+        elif any(float(np.hypot(*(q - truth.torso_sensor[k[0]]))) <= NEAR_M
+                 for q in tracks_in_sensor_frame([u.report() for u in tracker._tracks], tracker.last.pose)):
             out["no target, only an unreported track on them"] += 1
         else:
             out["no target, no track near them"] += 1

@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 
+from people_tracker.models.pose import Pose2D
+
 
 class TargetSelector:
     """Keeps one target track id, and the person's id when their track breaks.
@@ -98,9 +100,7 @@ class TargetSelector:
 
         Only the sensor's turn since is taken out (its heading from scan matching holds well
         even where its place drifts): the person's bearing turns back by as much."""
-        turn = self.yaw - self._yaw
-        c, s = math.cos(turn), math.sin(turn)
-        return np.array([c * q[0] + s * q[1], -s * q[0] + c * q[1]])
+        return Pose2D(0.0, 0.0, self._yaw - self.yaw).transform_points(np.asarray(q)[None])[0]
 
     def within_reach(self, stamp: float, q: np.ndarray) -> bool:
         """Whether the person could be at ``q`` (sensor frame, m) now."""

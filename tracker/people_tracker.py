@@ -505,7 +505,7 @@ class PeopleTracker:
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
                 passing = (np.hypot(*(walker.origin - stander.position)) > self.assoc.recover_radius_m
-                           and walker.updated_now and np.hypot(*walker.kf.x[1::2]) >= PASSING_MPS)
+                           and walker.updated_now and np.hypot(*walker.velocity) >= PASSING_MPS)
                 if not passing:  # born beside them (their own leg's track), or sliding onto them
                     out.add(k)
             else:

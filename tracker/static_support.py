@@ -72,10 +72,11 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         chosen[near] = True
         members = chosen[seg_of] & free
         p = pts[members]
-        if len(p) < min_points or np.hypot(*np.ptp(p, axis=0)) > max_size_m:
+        extent = np.hypot(*np.ptp(p, axis=0)) if len(p) else 0.0
+        if len(p) < min_points or extent > max_size_m:
             continue
         centre = p.mean(axis=0, keepdims=True)
         if max_leg_radius_m > 0:
-            centre = leg_centres(centre, np.hypot(*np.ptp(p, axis=0))[None], max_leg_radius_m)
+            centre = leg_centres(centre, np.array([extent]), max_leg_radius_m)
         out[t] = pose.transform_points(centre)[0]
     return out

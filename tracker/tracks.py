@@ -110,6 +110,11 @@ class TrackState:
         return self.kf.x[::2]  # state order [x, vx, y, vy]
 
     @property
+    def velocity(self) -> np.ndarray:
+        """Estimated velocity (vx, vy), world frame, m/s."""
+        return self.kf.x[1::2]
+
+    @property
     def position_cov(self) -> np.ndarray:
         """Its 2x2 covariance, m²."""
         return self.kf.P[::2, ::2]
