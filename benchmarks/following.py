@@ -52,7 +52,8 @@ def run_following(scene: str, laser: str, seed: int, duration: float | None = No
 
 
 def _job(args):
-    return run_following(*args)
+    scene, laser, seed, duration, config_path = args
+    return run_following(scene, laser, seed, duration, load_config(config_path))
 
 
 HEADER = (f"{'scene':<20} {'laser':<8} {'seed':>4} {'scans':>6} {'on %':>6} {'wrong':>5} {'chg':>4} {'lock s':>6} "
@@ -73,8 +74,11 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS))
     ap.add_argument("--duration", type=float, help="seconds of each scene (default: the scene's 10 minutes)")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--config", help="a configuration to score instead of the default (a YAML file or a shipped name)")
     args = ap.parse_args(argv)
-    jobs = [(s, laser, seed, args.duration) for s in args.scenes for laser in args.lasers for seed in args.seeds]
+    load_config(args.config)  # a bad configuration stops here, before any run
+    jobs = [(s, laser, seed, args.duration, args.config) for s in args.scenes for laser in args.lasers
+            for seed in args.seeds]
     print(HEADER, flush=True)
     results = []
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:

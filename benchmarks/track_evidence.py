@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,6 +144,23 @@ def calibration_table(confidence: np.ndarray, near: np.ndarray, min_samples: int
     return lines
 
 
+def _figures(job: tuple) -> dict:
+    """One scene run's figures (a worker process's job): (scene, seed, duration, config path)."""
+    name, seed, duration, config_path = job
+    run = run_scene(name, seed, duration, config=load_config(config_path))
+    return {**scene_figures(run), "scans": len(run.truths)}
+
+
+def _print_run(name: str, seed: int | None, duration: float | None, f: dict) -> None:
+    r = f["result"]
+    per_min = " ".join(f"{p:.1f}/{v:.1f}" for v, p in f["minutes"])
+    label = name if duration is None else f"{name} {duration:g}s"
+    print(f"{label:<22} {seed if seed is not None else '-':>4} {f['scans']:>6} {100 * r['mota']:>7.1f} "
+          f"{100 * f['strict']['mota']:>7.1f} "
+          f"{100 * r['idf1']:>7.1f} {r['id_switches']:>5} {r['false_positives']:>6} {r['misses']:>7} "
+          f"{f['ids_per_person']:>10} {f['false_lasting']:>9}  {per_min}", flush=True)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", nargs="+", default=["waiting_room", "crowd", "crossing", "stop_and_go", "occlusion",
@@ -152,7 +170,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--duration", type=float, default=None, help="override every scene's duration, s")
     ap.add_argument("--long-crowd", type=float, default=1200.0,
                     help="also run crowd this long (s) when crowd is listed; 0 skips it")
+    ap.add_argument("--config", help="a configuration to score instead of the default (a YAML file or a shipped name)")
+    ap.add_argument("--jobs", type=int, default=1, help="scene runs at once (each on one core)")
     args = ap.parse_args(argv)
+    load_config(args.config)  # a bad configuration stops here, before any run
     runs = []
     print(f"{'scene':<22} {'seed':>4} {'scans':>6} {'MOTA %':>7} {'strict':>7} {'IDF1 %':>7} {'IDsw':>5} {'FP':>6} {'misses':>7} "
           f"{'ids/person':>10} {'false>=2s':>9}  reported/visible per minute")
@@ -164,17 +185,11 @@ def main(argv: list[str] | None = None) -> int:
             jobs.append((name, None, args.duration))
         if name == "crowd" and args.long_crowd > 0 and args.duration is None:
             jobs.append((name, None, args.long_crowd))
-    for name, seed, duration in jobs:
-        run = run_scene(name, seed, duration)
-        f = scene_figures(run)
-        runs.append(f)
-        r = f["result"]
-        per_min = " ".join(f"{p:.1f}/{v:.1f}" for v, p in f["minutes"])
-        label = name if duration is None else f"{name} {duration:g}s"
-        print(f"{label:<22} {seed if seed is not None else '-':>4} {len(run.truths):>6} {100 * r['mota']:>7.1f} "
-              f"{100 * f['strict']['mota']:>7.1f} "
-              f"{100 * r['idf1']:>7.1f} {r['id_switches']:>5} {r['false_positives']:>6} {r['misses']:>7} "
-              f"{f['ids_per_person']:>10} {f['false_lasting']:>9}  {per_min}", flush=True)
+    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        figures = pool.map(_figures, [(name, seed, duration, args.config) for name, seed, duration in jobs])
+        for (name, seed, duration), f in zip(jobs, figures):
+            runs.append(f)
+            _print_run(name, seed, duration, f)
     conf = np.concatenate([f["confidence"] for f in runs]) if runs else np.zeros(0)
     near = np.concatenate([f["near"] for f in runs]) if runs else np.zeros(0, dtype=bool)
     print("\ncalibration of confidence over every run above (share of reported track-scans within "

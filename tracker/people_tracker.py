@@ -348,17 +348,39 @@ class PeopleTracker:
         return pairs + associate(rest, self.assoc.gate_chi2, self.assoc.method)
 
     def _recover(self, candidates: list[PersonCandidate], matched: list[tuple[int, int]]) -> list[tuple[int, int]]:
-        taken_t, taken_c = {t for t, _ in matched}, {c for _, c in matched}
-        # only tracks that lost their person within the last second
-        idle = [i for i, t in enumerate(self._tracks)
-                if t.confirmed and i not in taken_t and t.stamp - t.last_moving_update <= 1.0]
-        free = [k for k in range(len(candidates)) if k not in taken_c]
-        if not idle or not free or self.assoc.recover_radius_m <= 0:
+        """Leftover candidates for confirmed tracks the gate left alone: first tracks that lost
+        their walking person within the last second (sharp turns), within
+        ``association.recover_radius_m`` of where they were last seen moving; then people
+        standing still who set off, whose first step lands beyond a standing track's gate,
+        within half a stride (``pairing.max_leg_separation_m``) of where they stand. A
+        candidate within ``recover_radius_m`` of a walking track is never given to someone
+        standing: it is more likely the walker's."""
+        r = self.assoc.recover_radius_m
+        if r <= 0:
             return []
-        anchors = np.array([self._tracks[i].moving_position for i in idle])
+        taken_t, taken_c = {t for t, _ in matched}, {c for _, c in matched}
+        ts = self._tracks
+        lost = [i for i, t in enumerate(ts)
+                if t.confirmed and i not in taken_t and not t.still and t.stamp - t.last_moving_update <= 1.0]
+        pairs = self._recover_to(candidates, lost, [ts[i].moving_position for i in lost], taken_c, r)
+        taken_c |= {c for _, c in pairs}
+        walkers = np.array([t.position for t in ts if t.confirmed and not t.still]).reshape(-1, 2)
+        if len(walkers):
+            z = np.array([(c.x, c.y) for c in candidates]).reshape(-1, 2)
+            taken_c |= set(np.flatnonzero(pairwise_distances(z, walkers).min(axis=1) <= r).tolist())
+        standing = [i for i, t in enumerate(ts) if t.confirmed and i not in taken_t and t.still]
+        step = 0.5 * self.pairing.max_leg_separation_m  # the stepping leg lands within half a stride of them
+        return pairs + self._recover_to(candidates, standing, [ts[i].position for i in standing], taken_c, step)
+
+    def _recover_to(self, candidates: list[PersonCandidate], idle: list[int], anchors: list[np.ndarray],
+                    taken_c: set[int], radius_m: float) -> list[tuple[int, int]]:
+        """Give the free candidates within ``recover_radius_m`` of each idle track's anchor
+        (world frame, m) to the nearest, one each; those tracks forget their velocity."""
+        free = [k for k in range(len(candidates)) if k not in taken_c]
+        if not idle or not free:
+            return []
         z = np.array([(candidates[k].x, candidates[k].y) for k in free])
-        d = pairwise_distances(anchors, z)
-        pairs = associate(d, self.assoc.recover_radius_m, "gnn")
+        pairs = associate(pairwise_distances(np.array(anchors), z), radius_m, "gnn")
         for a, _ in pairs:
             self._tracks[idle[a]].forget_velocity()
         return [(idle[a], free[b]) for a, b in pairs]
@@ -490,7 +512,9 @@ class PeopleTracker:
         track born beside one standing still comes that close, it is the same person twice:
         the one that stood there longer keeps the place (with both still, the older track).
         A track that started farther away than ``association.recover_radius_m`` and walks on
-        (updated, at ``PASSING_MPS`` or faster) is someone passing close by, and stays."""
+        (seen moving within ``tracks.still_after_s``, at ``PASSING_MPS`` or faster; passing
+        in front of or behind the standing person hides one of them for a moment) is someone
+        passing close by, and stays."""
         sep = self.track_params.min_person_separation_m
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
         if len(idx) < 2 or sep <= 0:
@@ -505,7 +529,8 @@ class PeopleTracker:
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
                 passing = (np.hypot(*(walker.origin - stander.position)) > self.assoc.recover_radius_m
-                           and walker.updated_now and np.hypot(*walker.velocity) >= PASSING_MPS)
+                           and walker.stamp - walker.last_moving_update <= self.track_params.still_after_s
+                           and np.hypot(*walker.velocity) >= PASSING_MPS)
                 if not passing:  # born beside them (their own leg's track), or sliding onto them
                     out.add(k)
             else:

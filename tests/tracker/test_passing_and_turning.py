@@ -8,6 +8,7 @@ from people_tracker.models.pose import Pose2D
 from people_tracker.models.scenario import build_simulation
 from people_tracker.tracker.config import load_config
 from people_tracker.tracker.following import TargetSelector
+from people_tracker.tracker.pairing import PersonCandidate
 from people_tracker.tracker.people_tracker import PeopleTracker
 from people_tracker.tracker.static_support import static_support
 
@@ -70,3 +71,62 @@ def test_the_lost_person_is_looked_for_where_the_sensor_turned_them():
     where, reach = sel.expected(0.5)
     assert np.allclose(where, [0.0, -2.0], atol=1e-9)  # now on its right
     assert sel.within_reach(0.5, np.array([0.2, -2.1])) and not sel.within_reach(0.5, np.array([2.0, 0.0]))
+
+
+def _ids_of(spec: dict) -> dict[int, set]:
+    """Every track id reported nearest each visible person (within 0.4 m) over a scene."""
+    sim, n = build_simulation(spec)
+    tracker = PeopleTracker.from_config(load_config())
+    ids: dict[int, set] = {}
+    for _ in range(n):
+        st = sim.step()
+        tracks = tracker.step(st.scan, st.odom_pose @ sim.mount)
+        tr = st.truth
+        for p, xy, vis in zip(tr.person_id, tr.torso_world, tr.visible):
+            d = [np.hypot(t.x - xy[0], t.y - xy[1]) for t in tracks]
+            if vis and d and min(d) < 0.4:
+                ids.setdefault(int(p), set()).add(tracks[int(np.argmin(d))].track_id)
+    return ids
+
+
+def test_someone_who_stood_still_and_sets_off_briskly_keeps_their_id():
+    # walks in, stands 8 s, sets off at 1.3 m/s: the first step lands beyond the standing track's gate
+    spec = {"duration_s": 16.0, "laser": LASER, "world": {"room": [-1, -6, 9, 6]},
+            "people": [{"id": 1, "path": [[2.0, -3.0], [4.0, 0.0], [4.0, 5.0]], "speed": 1.3, "pauses": {1: 8.0}}]}
+    ids = _ids_of(spec)
+    assert ids.get(1) is not None and len(ids[1]) == 1, ids
+
+
+def _standing_and_walking(walker_at=None):
+    """A tracker with a confirmed track of someone who walked in and has stood still at
+    (3, 0) for 5 s and, optionally, a confirmed walker at ``walker_at`` (world frame, m)."""
+    tracker = PeopleTracker.from_config(load_config())
+    tracker._spawn([PersonCandidate(3.0, 0.0, 0.05, "pair")], 0.0)
+    stander = tracker._tracks[0]
+    for k in range(1, 51):  # static updates for 5 s: standing still
+        stander.predict(0.1 * k)
+        stander.update(np.array([3.0, 0.0]), np.eye(2) * 0.05 ** 2, moving=False)
+    stander.confirmed = True
+    if walker_at is not None:
+        tracker._spawn([PersonCandidate(*walker_at, 0.05, "pair")], 5.0)
+        tracker._tracks[1].confirmed = True
+        tracker._tracks[1].kf.x[1] = 1.0  # walking along x at 1 m/s
+    for t in tracker._tracks:
+        t.predict(5.1)
+    return tracker, stander
+
+
+def test_a_standing_person_who_sets_off_takes_their_first_step_beyond_the_gate():
+    tracker, stander = _standing_and_walking()
+    assert stander.still
+    step = [PersonCandidate(3.0, 0.37, 0.08, "leg")]  # the stepping leg, 0.37 m from where they stood
+    assert tracker._associate(step) == []  # outside a standing track's gate
+    assert tracker._recover(step, []) == [(0, 0)]
+    far = [PersonCandidate(3.0, 0.6, 0.08, "leg")]  # farther than half a stride: someone else
+    assert tracker._recover(far, []) == []
+
+
+def test_a_step_a_walker_could_have_made_is_not_given_to_someone_standing():
+    tracker, _ = _standing_and_walking(walker_at=(2.6, 0.9))
+    step = [PersonCandidate(3.0, 0.37, 0.08, "leg")]
+    assert all(t != 0 for t, _ in tracker._recover(step, []))
