@@ -549,9 +549,19 @@ class PeopleTracker:
         min(young, key=lambda u: np.hypot(*(u.origin - t.position))).track_id = t.track_id
         return True
 
+    def _set_off(self, t: TrackState, stamp: float) -> bool:
+        """Someone standing still who set off with a first step beyond reach: a confirmed
+        walking track was born beside them (within ``association.recover_radius_m``) and
+        their standing track has had no update since. Walking away along the line of
+        sight hides the place they left, so its emptiness may never be seen."""
+        if not (t.confirmed and t.moved and t.still) or t.updated_now:
+            return False
+        return any(u.confirmed and not u.still and u.born >= t.last_update and stamp - u.born <= 3.0 and
+                   np.hypot(*(u.origin - t.position)) <= self.assoc.recover_radius_m for u in self._tracks)
+
     def _delete(self, stamp: float) -> None:
         duplicates = self._duplicates()
-        dying = [t for i, t in enumerate(self._tracks) if i not in duplicates and t.dead()]
+        dying = [t for i, t in enumerate(self._tracks) if i not in duplicates and (t.dead() or self._set_off(t, stamp))]
         keep = [t for i, t in enumerate(self._tracks) if i not in duplicates and not (t in dying)]
         for t in dying:
             if t.furniture() and t.existence.probability >= self.existence.delete:

@@ -108,9 +108,11 @@ def _standing_and_walking(walker_at=None):
         stander.update(np.array([3.0, 0.0]), np.eye(2) * 0.05 ** 2, moving=False)
     stander.confirmed = True
     if walker_at is not None:
-        tracker._spawn([PersonCandidate(*walker_at, 0.05, "pair")], 5.0)
-        tracker._tracks[1].confirmed = True
-        tracker._tracks[1].kf.x[1] = 1.0  # walking along x at 1 m/s
+        tracker._spawn([PersonCandidate(9.0, 9.0, 0.05, "pair")], 5.0)  # (clear of the spawn exclusion) ...
+        walker = tracker._tracks[1]
+        walker.kf.x[::2] = walker.origin = np.array(walker_at, dtype=float)  # ... and put where wanted
+        walker.confirmed = True
+        walker.kf.x[1] = 1.0  # walking along x at 1 m/s
     for t in tracker._tracks:
         t.predict(5.1)
     return tracker, stander
@@ -130,3 +132,18 @@ def test_a_step_a_walker_could_have_made_is_not_given_to_someone_standing():
     tracker, _ = _standing_and_walking(walker_at=(2.6, 0.9))
     step = [PersonCandidate(3.0, 0.37, 0.08, "leg")]
     assert all(t != 0 for t, _ in tracker._recover(step, []))
+
+
+def test_a_walker_born_beside_someone_who_is_no_longer_seen_standing_takes_their_id():
+    # they set off walking away along the line of sight: the place they left stays hidden
+    tracker, stander = _standing_and_walking(walker_at=(3.3, 0.4))
+    tracker._delete(5.1)
+    assert [t.track_id for t in tracker._tracks] == [1]  # the walker, with the standing person's id
+    assert tracker._tracks[0] is not stander
+
+
+def test_someone_still_seen_standing_keeps_their_track_beside_a_newcomer():
+    tracker, stander = _standing_and_walking(walker_at=(3.3, 0.4))
+    stander.update(np.array([3.0, 0.0]), np.eye(2) * 0.05 ** 2, moving=False)  # still there this scan
+    tracker._delete(5.1)
+    assert sorted(t.track_id for t in tracker._tracks) == [1, 2]
