@@ -2,19 +2,35 @@
 
 Usage::
 
-    python benchmarks/bench_pipeline.py [BAG] [--people 50] [--repeat N]
+    python benchmarks/bench_pipeline.py [BAG] [--people 10 50 100] [--hour]
 
-On the real recording, each scan's time covers reading it (with its poses) from the bag
-and the tracker's step; on the crowd scene (scaled to ``--people``) the simulator's
-rendering is left out and only the tracker's step is timed. Prints scans per second,
-p50/p99 milliseconds per scan and the peak resident memory, on one core.
+Three parts, each on one core (the process pins itself to its first allowed CPU):
+
+* **in-process**: on the real recording each scan's time covers reading it (with its
+  poses) from the bag and the tracker's step; on the crowd scene (one row per ``--people``)
+  the simulator's rendering is left out and only the tracker's step is timed. Scans per
+  second, p50/p99 milliseconds per scan.
+* **whole program**: ``people-tracker run BAG --tracks t.csv`` as a user runs it, on a long
+  and a short recording of the same laser; the marginal rate ``(n1 - n2) / (t1 - t2)``
+  leaves the start-up (imports, opening the bag) out. The real pair is
+  general_tracking_moving_1.bag (873 scans) and training/positive_2.bag (243 scans, same
+  laser); the simulated pair is ``follow_outdoor`` with its 86°, 0.35° laser (245 beams),
+  150 s and 30 s, written to a temporary folder. Best of three runs each.
+* ``--hour``: resident memory after the first minute and at the end of a one-hour
+  simulated crowd (30 people), which should be flat.
+
+Peak resident memory of the benchmark process closes the output.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import re
 import resource
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -25,7 +41,9 @@ from people_tracker.tracker.config import load_config
 from people_tracker.tracker.io.recording import Recording
 from people_tracker.tracker.people_tracker import PeopleTracker
 
-DEFAULT_BAG = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh"
+DEFAULT_BAG = DATA / "general_tracking_moving_1.bag"
+SHORT_BAG = DATA / "training" / "positive_2.bag"  # the same laser, 243 scans
 
 
 def _row(name: str, seconds: list[float], extra: str = "") -> None:
@@ -59,12 +77,90 @@ def bench_crowd(people: int, config, scans: int) -> tuple[list[float], float]:
     return times, reported / max(len(times), 1)
 
 
+def run_program(bag: Path, out: Path, repeat: int = 3) -> tuple[int, float]:
+    """Scans read and the best wall time (s) of ``people-tracker run BAG --tracks`` on this core."""
+    cmd = [sys.executable, "-m", "people_tracker", "run", str(bag), "--tracks", str(out)]
+    best, scans = float("inf"), 0
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        done = subprocess.run(cmd, capture_output=True, text=True, check=True)
+        best = min(best, time.perf_counter() - t0)
+        m = re.search(r"scans: (\d+) read", done.stderr + done.stdout)
+        scans = int(m.group(1)) if m else 0
+    return scans, best
+
+
+def _marginal(name: str, long: Path, short: Path, out: Path) -> None:
+    (n1, t1), (n2, t2) = run_program(long, out), run_program(short, out)
+    rate = (n1 - n2) / (t1 - t2) if t1 > t2 else float("nan")
+    print(f"{name:<44} {rate:>8.0f}   ({n1} scans in {t1:.2f} s, {n2} in {t2:.2f} s)")
+
+
+def bench_whole_program() -> None:
+    print(f"{'whole program (people-tracker run --tracks)':<44} {'scans/s':>8}   marginal: (n1 - n2) / (t1 - t2)")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "t.csv"
+        if DEFAULT_BAG.exists() and SHORT_BAG.exists():
+            _marginal("moving_1.bag (873) - positive_2.bag (243)", DEFAULT_BAG, SHORT_BAG, out)
+        else:
+            print("real recordings: not found (they live in ../shared/data)")
+        bags = []
+        for seconds in (150, 30):
+            bag = Path(tmp) / f"follow_{seconds}"
+            subprocess.run([sys.executable, "-m", "people_tracker", "-q", "simulate", "follow_outdoor", "--laser", "narrow",
+                            "--duration", str(seconds), "--output", str(bag)], check=True, capture_output=True)
+            bags.append(bag)
+        _marginal("follow_outdoor 86 deg, 245 beams (150 s - 30 s)", bags[0], bags[1], out)
+
+
+def _rss_mib() -> float:
+    """Resident memory of this process now, MiB (Linux; nan elsewhere)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return float("nan")
+
+
+def bench_hour(config) -> None:
+    sim, n = build_simulation({**load_scenario("crowd"), "duration_s": 3600.0})
+    tracker = PeopleTracker.from_config(config)
+    first, start = None, None
+    t0 = time.perf_counter()
+    for _ in range(n):
+        st = sim.step()
+        tracker.step(st.scan, st.odom_pose, st.odom_pose_last_beam)
+        start = st.scan.stamp if start is None else start
+        if first is None and st.scan.stamp - start >= 60.0:
+            first = _rss_mib()
+    print(f"one hour of the crowd (30 people, {n} scans, {time.perf_counter() - t0:.0f} s): resident memory "
+          f"{first:.0f} MiB after the first minute, {_rss_mib():.0f} MiB at the end")
+
+
+def _one_core() -> None:
+    """Pin every thread of this process (numpy's BLAS threads too) and its children to one
+    core, as ``taskset -c CPU`` would (Linux; elsewhere nothing is pinned)."""
+    if not hasattr(os, "sched_setaffinity"):
+        return
+    cpu = {min(os.sched_getaffinity(0))}
+    tasks = Path("/proc/self/task")
+    for tid in ([int(t) for t in os.listdir(tasks)] if tasks.exists() else [0]):
+        try:
+            os.sched_setaffinity(tid, cpu)
+        except OSError:
+            pass
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("bag", nargs="?", default=str(DEFAULT_BAG))
-    ap.add_argument("--people", type=int, default=50)
+    ap.add_argument("--people", type=int, nargs="+", default=[10, 50, 100])
     ap.add_argument("--scans", type=int, default=300, help="crowd scans to time")
+    ap.add_argument("--hour", action="store_true", help="also the memory over a one-hour crowd (about 10 minutes)")
     args = ap.parse_args(argv)
+    _one_core()
     config = load_config()
     print(f"{'pipeline':<44} {'scans/s':>8} {'p50 ms':>8} {'p99 ms':>8}  tracks/scan")
     if Path(args.bag).exists():
@@ -72,8 +168,12 @@ def main(argv=None) -> int:
         _row(f"{Path(args.bag).name} (read+track)", times, f"{per:.2f}")
     else:
         print(f"{Path(args.bag).name}: not found (the real recordings live in ../shared/data)")
-    times, per = bench_crowd(args.people, config, args.scans)
-    _row(f"crowd scene, {args.people} people (track only)", times, f"{per:.2f}")
+    for people in args.people:
+        times, per = bench_crowd(people, config, args.scans)
+        _row(f"crowd scene, {people} people (track only)", times, f"{per:.2f}")
+    bench_whole_program()
+    if args.hour:
+        bench_hour(config)
     print(f"peak resident memory: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")
     return 0
 

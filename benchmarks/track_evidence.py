@@ -18,9 +18,10 @@ track-scans whose confidence falls in a 0.1-wide bin, the share within 0.5 m of 
 
 Usage::
 
-    python benchmarks/track_evidence.py                          # every figure (about 10 min)
+    python benchmarks/track_evidence.py --jobs 2                 # every figure (about 10 min on 2 cores)
     python benchmarks/track_evidence.py --scenes waiting_room --seeds 21
     python benchmarks/track_evidence.py --scenes crowd --duration 1200
+    python benchmarks/track_evidence.py --config mine.yaml       # score another configuration
 """
 
 from __future__ import annotations
