@@ -17,12 +17,6 @@ line's ``--help`` stay fast.
 from __future__ import annotations
 
 from importlib import import_module
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("people-tracker")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree without installing
-    __version__ = "0+unknown"
 
 _API = {
     "PeopleTracker": "people_tracker.tracker.people_tracker",
@@ -37,6 +31,15 @@ __all__ = sorted(_API) + ["__version__"]
 
 
 def __getattr__(name: str):
+    if name == "__version__":  # looked up on first use: importlib.metadata takes 20 ms to import
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            value = version("people-tracker")
+        except PackageNotFoundError:  # pragma: no cover - running from a source tree without installing
+            value = "0+unknown"
+        globals()[name] = value
+        return value
     if name in _API:
         value = getattr(import_module(_API[name]), name)
         globals()[name] = value

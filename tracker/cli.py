@@ -16,8 +16,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from people_tracker.tracker.errors import InputError, require
 
 PROG = "people-tracker"
@@ -96,11 +94,19 @@ def _scenario_list() -> str:
     return "\n".join(lines)
 
 
-def _build_parser() -> argparse.ArgumentParser:
-    from people_tracker import __version__
+class _Version(argparse.Action):
+    """``--version``: the installed version, looked up only when asked (``--help`` stays fast)."""
 
+    def __call__(self, parser, namespace, values, option_string=None):
+        from people_tracker import __version__
+
+        print(f"{PROG} {__version__}")
+        parser.exit()
+
+
+def _build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog=PROG, description="Find and follow walking people in 2D laser scans.")
-    p.add_argument("--version", action="version", version=f"{PROG} {__version__}")
+    p.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     _volume(p, False)
     common = argparse.ArgumentParser(add_help=False)
     _volume(common, argparse.SUPPRESS)
@@ -281,6 +287,8 @@ def _make_sink(args):
 
 
 def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
+    import numpy as np
+
     from people_tracker.tracker.config import dump_config
     from people_tracker.tracker.io import outputs
     from people_tracker.tracker.io.atomic import atomic_output
@@ -453,6 +461,8 @@ def _bag_and_topic(arg: str) -> tuple[str, str | None]:
 
 
 def _cmd_train_legs(args) -> int:
+    import numpy as np
+
     from people_tracker.tracker import train_legs as T
     from people_tracker.tracker.io.atomic import atomic_output, check_outputs
 
