@@ -91,6 +91,7 @@ class StepResult:
 
 
 PASSING_MPS = 0.5  # m/s: a track this fast passing close by someone standing is a passer-by, not them twice
+SET_OFF_S = 3.0  # s: a track this young that began beside someone standing may be them, set off
 
 
 class PeopleTracker:
@@ -374,8 +375,8 @@ class PeopleTracker:
 
     def _recover_to(self, candidates: list[PersonCandidate], idle: list[int], anchors: list[np.ndarray],
                     taken_c: set[int], radius_m: float) -> list[tuple[int, int]]:
-        """Give the free candidates within ``recover_radius_m`` of each idle track's anchor
-        (world frame, m) to the nearest, one each; those tracks forget their velocity."""
+        """Give the free candidates within ``radius_m`` of each idle track's anchor (world
+        frame, m) to the nearest, one each; those tracks forget their velocity."""
         free = [k for k in range(len(candidates)) if k not in taken_c]
         if not idle or not free:
             return []
@@ -537,13 +538,19 @@ class PeopleTracker:
                 out.add(idx[b] if ta.born <= tb.born else idx[a])
         return out
 
+    def _born_beside(self, t: TrackState, tracks: list[TrackState], stamp: float) -> list[TrackState]:
+        """The tracks of ``tracks`` born within ``SET_OFF_S`` before ``stamp`` whose first
+        place lies within ``association.recover_radius_m`` of ``t``: someone standing there
+        who set off, perhaps."""
+        return [u for u in tracks if stamp - u.born <= SET_OFF_S and
+                np.hypot(*(u.origin - t.position)) <= self.assoc.recover_radius_m]
+
     def _hand_over(self, t: TrackState, living: list[TrackState], stamp: float) -> bool:
         """A person who stood still and set off: their place empties (the standing track
         dies) while a new track starts beside it, which takes the standing one's id."""
         if not (t.confirmed and t.moved and t.still):
             return False
-        young = [u for u in living if stamp - u.born <= 3.0 and u.track_id > t.track_id and
-                 np.hypot(*(u.origin - t.position)) <= self.assoc.recover_radius_m]
+        young = [u for u in self._born_beside(t, living, stamp) if u.track_id > t.track_id]
         if not young:
             return False
         min(young, key=lambda u: np.hypot(*(u.origin - t.position))).track_id = t.track_id
@@ -551,13 +558,13 @@ class PeopleTracker:
 
     def _set_off(self, t: TrackState, stamp: float) -> bool:
         """Someone standing still who set off with a first step beyond reach: a confirmed
-        walking track was born beside them (within ``association.recover_radius_m``) and
-        their standing track has had no update since. Walking away along the line of
-        sight hides the place they left, so its emptiness may never be seen."""
+        walking track was born beside them and their standing track has had no update
+        since. Walking away along the line of sight hides the place they left, so its
+        emptiness may never be seen."""
         if not (t.confirmed and t.moved and t.still) or t.updated_now:
             return False
-        return any(u.confirmed and not u.still and u.born >= t.last_update and stamp - u.born <= 3.0 and
-                   np.hypot(*(u.origin - t.position)) <= self.assoc.recover_radius_m for u in self._tracks)
+        return any(u.confirmed and not u.still and u.born >= t.last_update
+                   for u in self._born_beside(t, self._tracks, stamp))
 
     def _delete(self, stamp: float) -> None:
         duplicates = self._duplicates()
