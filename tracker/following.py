@@ -8,7 +8,10 @@ measures well even there, is taken out when the person is looked for after a gap
 turning after its person swings them across its view. When the target's track breaks off, or
 coasts while a fresh track appears where the person should be, the person's id goes to the
 track at that place — when exactly one is there; when more than one could be them, the
-person is reported lost rather than swapped for someone else.
+person is reported lost rather than swapped for someone else. When nobody is where they
+should be for a moment, an ``auto`` selector gives their id to the one person in front of
+the robot (the place it follows people in), if there is exactly one: a robot following
+someone has them in front of it, wherever a drifting or turned estimate says they went.
 """
 
 from __future__ import annotations
@@ -37,6 +40,10 @@ class TargetSelector:
         Another track takes the id when it lies within ``reacquire_m`` metres of where the
         person should be relative to the sensor, the radius growing at ``walk_mps`` with the
         time since their track was last updated, up to ``max_reach_m``.
+    relock_s : float
+        ``auto`` only: when the person has been lost this long (s) and nobody is within
+        reach of where they should be, the one reported track in the lock zone ahead (none
+        when there are several) takes their id, and their place is learnt afresh from it.
     coast_s : float
         A target track not updated for this long (s), while exactly one other track was
         updated where the person should be, gives the id to that one.
@@ -50,12 +57,13 @@ class TargetSelector:
     def __init__(self, mode: str | int | None, reacquire_s: float = 10.0, reacquire_m: float = 0.8,
                  ahead_deg: float = 60.0, lock_range_m: float = 3.5, walk_mps: float = 1.5,
                  coast_s: float = 0.5, max_reach_m: float = 4.0, steady_s: float = 1.5,
-                 slide_m: float = 0.6) -> None:
+                 slide_m: float = 0.6, relock_s: float = 1.0) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
-        self._ahead, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
+        self._ahead_rad, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
         self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
+        self._relock_s = relock_s
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
         self._v = np.zeros(2)  # ... its rate of change (m/s) ...
@@ -133,20 +141,32 @@ class TargetSelector:
                 self.target, self._q, self._t, self._v, self.steady = None, None, None, np.zeros(2), None
             return None
         best = self.only_one_near(stamp, others)
+        if best is None and self.mode == "auto" and stamp - self.lost_since >= self._relock_s:
+            best = self._ahead(others, only=True)  # nobody where they should be: the person is the one in front
+            if best is not None:  # where they are now is learnt afresh
+                self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
         if best is not None:
             self.lost_since = None
             self.events.append(f"re-acquired {self.target}")
         return best
 
+    def _ahead(self, tracks: dict[int, np.ndarray], only: bool = False) -> int | None:
+        """The closest track (id → sensor-frame place, m) in the follow zone ahead (with
+        ``only``, the one track there), or None."""
+        best, best_r, n = None, math.inf, 0
+        for tid, (x, y) in tracks.items():
+            r, bearing = math.hypot(x, y), math.atan2(y, x)
+            if abs(bearing) <= self._ahead_rad and r <= self._lock_range:
+                n += 1
+                if r < best_r:
+                    best, best_r = tid, r
+        return None if only and n > 1 else best
+
     def choose(self, reported: dict[int, np.ndarray]) -> int | None:
         """The target id now, given reported tracks (id → sensor-frame place, m)."""
         if self.target is not None or self.mode != "auto":
             return self.target
-        best, best_r = None, math.inf
-        for tid, (x, y) in reported.items():
-            r, bearing = math.hypot(x, y), math.atan2(y, x)
-            if abs(bearing) <= self._ahead and r <= self._lock_range and r < best_r:
-                best, best_r = tid, r
+        best = self._ahead(reported)
         if best is not None:
             self.target = best
             self.events.append(f"target {best}")

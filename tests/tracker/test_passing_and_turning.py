@@ -79,6 +79,28 @@ def test_the_lost_person_is_looked_for_where_the_sensor_turned_them():
     assert sel.within_reach(0.5, np.array([0.2, -2.1])) and not sel.within_reach(0.5, np.array([2.0, 0.0]))
 
 
+def test_a_lost_person_is_the_one_track_in_front_when_nobody_is_where_they_should_be():
+    sel = TargetSelector("auto")
+    sel.target = 1
+    sel.seen(0.0, np.array([2.0, 2.0]))  # last seen ahead on the left
+    sel.yaw = math.pi  # the robot turned round: they should be behind it on the right now
+    sel.lost(0.2)
+    in_front, behind = np.array([2.2, 0.1]), np.array([-3.0, 1.0])  # neither within reach of where they should be
+    assert sel.reacquire(0.8, {7: in_front, 8: behind}) is None  # too soon: they may come back where expected
+    assert sel.reacquire(1.3, {7: in_front, 8: behind}) == 7  # the one person in front of the robot is them
+    assert sel.lost_since is None and sel.expected(1.3) is None  # their place is learnt afresh from that track
+
+
+def test_a_lost_person_is_not_guessed_among_several_in_front():
+    sel = TargetSelector("auto")
+    sel.target = 1
+    sel.seen(0.0, np.array([2.0, 2.0]))
+    sel.yaw = math.pi
+    sel.lost(0.2)
+    assert sel.reacquire(1.3, {7: np.array([2.2, 0.1]), 9: np.array([3.0, -0.5])}) is None  # lost, not swapped
+    assert TargetSelector(5).reacquire(1.3, {7: np.array([2.2, 0.1])}) is None  # an id given by the user: never
+
+
 def test_someone_who_stood_still_and_sets_off_briskly_keeps_their_id():
     # walks in, stands 8 s, sets off at 1.3 m/s: the first step lands beyond the standing track's gate
     spec = {"duration_s": 16.0, "laser": LASER, "world": {"room": [-1, -6, 9, 6]},
