@@ -187,8 +187,8 @@ class StandingConfig:
     min_leg_probability: float = field(metadata=_spec(lo=0.0, hi=1.0))
     min_leg_separation_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
     max_leg_separation_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=5.0))
-    confirm_scans: int = field(metadata=_spec(lo=1, hi=1000))
-    confirm_window: int = field(metadata=_spec(lo=1, hi=1000))
+    confirm_window_s: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=60.0))
+    confirm_share: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1.0))
     confirm_radius_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     furniture_radius_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
 
@@ -317,7 +317,7 @@ def _check_value(name: str, value: Any, typ: type, spec: dict) -> Any:
 
 # pairs of keys of one section where the first must not exceed the second (besides every
 # min_X and max_X, found by name)
-_ORDERED = (("confirm_scans", "confirm_window"), ("delete", "keep"), ("keep", "confirm"))
+_ORDERED = (("delete", "keep"), ("keep", "confirm"))
 
 
 def _check_order(values: dict, where: str) -> None:

@@ -460,7 +460,7 @@ class PeopleTracker:
         if not self.standing.params.enabled:
             return
         xy = np.array([(c.x, c.y) for c in standing]).reshape(-1, 2)
-        persistent = self.standing.persistent(xy)
+        persistent = self.standing.persistent(xy, stamp)
         self._spawn([standing[k] for k in np.flatnonzero(persistent)], stamp, standing=True)
 
     def _seen_empty(self, xy: np.ndarray, stamp: float) -> np.ndarray:

@@ -4,8 +4,9 @@ Someone who stands still never moves, so motion detection (the paper's method) n
 reports them; on the annotated hallway recording most of the people are standing. Their
 legs still look like legs: two segments the leg model (:mod:`people_tracker.models.leg_model`) finds
 likely enough, a stance apart. Such a pair starts a tentative track
-only when it comes back at the same place in the world in most of the last few scans (a
-one-off coincidence of two unrelated segments does not), never near an existing track,
+only when it comes back at the same place in the world in most of the scans of the last
+fraction of a second (a one-off coincidence of two unrelated segments does not; seconds, so
+a 40 Hz laser asks for the same persistence as a 7.5 Hz one), never near an existing track,
 and never where a standing track was already ended as furniture. The track is confirmed
 by its evidence (:mod:`people_tracker.tracker.existence`): its place was seen empty before,
 or it moves. One that never moved, on a place never seen empty, and was never confirmed
@@ -26,7 +27,7 @@ from people_tracker.tracker.pairing import nearest_pairs
 
 @dataclass(frozen=True)
 class StandingParams:
-    """Attributes (metres, scans)
+    """Attributes (metres, seconds)
     ----------
     enabled : bool
         Look for standing people at all.
@@ -34,9 +35,11 @@ class StandingParams:
         A segment is a standing leg when the leg model gives it at least this probability.
     min_leg_separation_m, max_leg_separation_m : float
         Distance between the two legs of a standing person, metres.
-    confirm_scans, confirm_window : int
+    confirm_window_s, confirm_share : float
         A pair starts a track when pairs were found within ``confirm_radius_m`` of it in at
-        least ``confirm_scans`` of the last ``confirm_window`` scans (this one included).
+        least this share of the scans of the last ``confirm_window_s`` seconds (this one
+        included; stamps within the window's length of this scan's), once those scans span
+        half the window and number two or more. At 7.5 Hz, 0.6 s and 0.6 are 3 of 5 scans.
     confirm_radius_m : float
         How far apart (world frame) the pairs of those scans may be, metres.
     furniture_radius_m : float
@@ -47,8 +50,8 @@ class StandingParams:
     min_leg_probability: float = 0.3
     min_leg_separation_m: float = 0.1
     max_leg_separation_m: float = 0.5
-    confirm_scans: int = 3
-    confirm_window: int = 5
+    confirm_window_s: float = 0.6
+    confirm_share: float = 0.6
     confirm_radius_m: float = 0.2
     furniture_radius_m: float = 0.5
 
@@ -71,19 +74,26 @@ class StandingInitiator:
 
     def __init__(self, params: StandingParams, max_places: int = 1000) -> None:
         self.params = params
-        self._recent: deque[np.ndarray] = deque(maxlen=params.confirm_window)
+        self._recent: deque[tuple[float, np.ndarray]] = deque()  # (stamp (s), pairs (world frame, m))
         self._furniture: deque[np.ndarray] = deque(maxlen=max_places)
 
-    def persistent(self, pairs_world: np.ndarray) -> np.ndarray:
-        """Record this scan's pairs; return which of them persisted (bool, shape (k,))."""
-        self._recent.append(pairs_world)
+    def persistent(self, pairs_world: np.ndarray, stamp: float) -> np.ndarray:
+        """Record this scan's pairs (world frame, m) at ``stamp`` (s); return which of them
+        persisted (bool, shape (k,))."""
         p = self.params
+        recent = self._recent
+        recent.append((stamp, pairs_world))
+        while recent and recent[0][0] <= stamp - p.confirm_window_s + 1e-6:  # the window is (stamp - w, stamp]
+            recent.popleft()
         seen = np.zeros(len(pairs_world), dtype=np.int64)
-        for earlier in self._recent:
+        for _, earlier in recent:
             if len(earlier) and len(pairs_world):
                 d = pairwise_distances(pairs_world, earlier)
                 seen += d.min(axis=1) <= p.confirm_radius_m
-        ok = seen >= p.confirm_scans
+        span = stamp - recent[0][0]
+        if len(recent) < 2 or span < 0.5 * p.confirm_window_s:
+            return np.zeros(len(pairs_world), dtype=bool)
+        ok = seen >= p.confirm_share * len(recent) - 1e-9
         if ok.any() and self._furniture:
             f = np.array(self._furniture)
             d = pairwise_distances(pairs_world, f)

@@ -158,6 +158,22 @@ def test_evidence_per_second_does_not_depend_on_the_scan_rate():
     assert walk(5.0) < walk(10.0)
 
 
+def test_a_standing_pair_must_persist_as_long_at_any_scan_rate():
+    from people_tracker.tracker.standing import StandingInitiator, StandingParams
+
+    def starts(rate_hz: float, present_s: float) -> bool:
+        """Whether a leg pair at (2, 0) for ``present_s`` seconds, after 1 s with none, starts a track."""
+        init, started = StandingInitiator(StandingParams()), False
+        pair, none = np.array([[2.0, 0.0]]), np.zeros((0, 2))
+        for k in range(int(round(1.0 * rate_hz))):
+            init.persistent(none, k / rate_hz)
+        for k in range(int(round(present_s * rate_hz))):
+            started |= bool(init.persistent(pair, 1.0 + k / rate_hz).any())
+        return started
+    assert starts(7.5, 3 / 7.5) and not starts(7.5, 2 / 7.5)  # 3 of 5 scans at 7.5 Hz, as ever
+    assert not starts(40.0, 0.1)  # 4 scans of a 40 Hz laser are a tenth of a second: a coincidence
+    assert starts(40.0, 0.4) and not starts(40.0, 0.3)  # the same time as at 7.5 Hz
+
 def test_tentative_track_that_does_not_move_never_confirms():
     t, R = new_track(2.0, 2.0, TrackParams(confirm_min_travel_m=0.4, max_tentative_s=1.0))
     for k in range(1, 12):
