@@ -62,6 +62,8 @@ class PersonCandidate:
         ``pair``, ``leg``, ``blob`` (from moving objects) or ``static`` (static support).
     object_ids : tuple of int
         The moving objects it was made from.
+    legs : tuple of (float, float)
+        A standing pair's two leg centres, world frame, metres (empty for other kinds).
     """
 
     x: float
@@ -69,6 +71,7 @@ class PersonCandidate:
     sigma: float
     kind: str
     object_ids: tuple[int, ...] = ()
+    legs: tuple[tuple[float, float], ...] = ()
 
     @property
     def R(self) -> np.ndarray:

@@ -433,9 +433,13 @@ class PeopleTracker:
             pts = scan.valid_points
             widths = np.hypot(*(pts[legs.stop[keep] - 1] - pts[legs.start[keep]]).T)
             xy = leg_centres(xy, widths, self.pairing.max_leg_radius_m)
-        mids = standing_pairs(xy, p)
-        xy = world.transform_points(mids) if len(mids) else mids
-        return [PersonCandidate(float(x), float(y), self.pairing.sigma_pair_m, "standing") for x, y in xy]
+        mids, pair_legs_xy = standing_pairs(xy, p)
+        if not len(mids):
+            return []
+        xy = world.transform_points(mids)
+        legs_w = world.transform_points(pair_legs_xy.reshape(-1, 2)).reshape(-1, 2, 2)
+        return [PersonCandidate(float(x), float(y), self.pairing.sigma_pair_m, "standing",
+                                legs=tuple(map(tuple, lw.tolist()))) for (x, y), lw in zip(xy, legs_w)]
 
     def _update_standing(self, standing: list[PersonCandidate]) -> set[int]:
         """Standing pairs update confirmed tracks no moving candidate reached; their indices."""
@@ -488,7 +492,10 @@ class PeopleTracker:
             place, arrived = None, True
             if standing:
                 place = self._place_history(xy, stamp)
-                arrived = place == PlaceMemory.EMPTY or bool(self._seen_empty(xy[None], stamp)[0])
+                # where the legs stand now was seen through lately (not the gap between them,
+                # which a laser sees through whoever stands there): someone arrived
+                legs = np.array(c.legs).reshape(-1, 2) if c.legs else xy[None]
+                arrived = place == PlaceMemory.EMPTY or bool(self._seen_empty(legs, stamp).all())
             ex = Existence(self.existence, stamp, standing, arrived, None if best[k] != best[k] else float(best[k]),
                            self.leg_model.base_rate)
             self._tracks.append(TrackState(self._next_id, c.x, c.y, c.R, stamp, self.track_params, ex, standing))

@@ -56,13 +56,15 @@ class StandingParams:
     furniture_radius_m: float = 0.5
 
 
-def standing_pairs(legs_xy: np.ndarray, params: StandingParams) -> np.ndarray:
-    """Midpoints of the nearest disjoint leg pairs a stance apart, shape (k, 2), same frame."""
+def standing_pairs(legs_xy: np.ndarray, params: StandingParams) -> tuple[np.ndarray, np.ndarray]:
+    """The nearest disjoint leg pairs a stance apart: their midpoints, shape (k, 2), and
+    their two legs, shape (k, 2, 2), in the frame of ``legs_xy``."""
     pairs = nearest_pairs(legs_xy, params.min_leg_separation_m, params.max_leg_separation_m)
     if not pairs:
-        return np.zeros((0, 2))
+        return np.zeros((0, 2)), np.zeros((0, 2, 2))
     i, j = np.array(pairs).T
-    return 0.5 * (legs_xy[i] + legs_xy[j])
+    legs = np.stack([legs_xy[i], legs_xy[j]], axis=1)
+    return legs.mean(axis=1), legs
 
 
 class StandingInitiator:
