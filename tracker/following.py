@@ -8,10 +8,11 @@ measures well even there, is taken out when the person is looked for after a gap
 turning after its person swings them across its view. When the target's track breaks off, or
 coasts while a fresh track appears where the person should be, the person's id goes to the
 track at that place — when exactly one is there; when more than one could be them, the
-person is reported lost rather than swapped for someone else. When nobody is where they
-should be for a moment, an ``auto`` selector gives their id to the one person in front of
-the robot (the place it follows people in), if there is exactly one: a robot following
-someone has them in front of it, wherever a drifting or turned estimate says they went.
+person is reported lost rather than swapped for someone else. An ``auto`` selector (the
+robot follows whoever it locked onto in front of it) gives a lost person's id instead to
+the one person in front of the robot after a moment, if there is exactly one: a robot
+following someone has them in front of it, wherever a drifting or turned estimate says
+they went, and the one track near that estimate was more often a passer-by than them.
 """
 
 from __future__ import annotations
@@ -37,13 +38,14 @@ class TargetSelector:
         How long (s) after the target's track broke off another track may still take the
         person's id; then an ``auto`` selector locks anew.
     reacquire_m, walk_mps : float
-        Another track takes the id when it lies within ``reacquire_m`` metres of where the
-        person should be relative to the sensor, the radius growing at ``walk_mps`` with the
-        time since their track was last updated, up to ``max_reach_m``.
+        Where the person may be: within ``reacquire_m`` metres of where they should be
+        relative to the sensor, the radius growing at ``walk_mps`` with the time since their
+        track was last updated, up to ``max_reach_m``. With an id given, the one other track
+        there takes the id of a lost person.
     relock_s : float
-        ``auto`` only: when the person has been lost this long (s) and nobody is within
-        reach of where they should be, the one reported track in the lock zone ahead (none
-        when there are several) takes their id, and their place is learnt afresh from it.
+        ``auto``: when the person has been lost this long (s), the one reported track in the
+        lock zone ahead (none when there are several) takes their id, and their place is
+        learnt afresh from it.
     coast_s : float
         A target track not updated for this long (s), while exactly one other track was
         updated where the person should be, gives the id to that one.
@@ -140,11 +142,14 @@ class TargetSelector:
             if self.mode == "auto":
                 self.target, self._q, self._t, self._v, self.steady = None, None, None, np.zeros(2), None
             return None
-        best = self.only_one_near(stamp, others)
-        if best is None and self.mode == "auto" and stamp - self.lost_since >= self._relock_s:
-            best = self._ahead(others, only=True)  # nobody where they should be: the person is the one in front
+        if self.mode != "auto":  # the id goes to the one track within reach of where they should be
+            best = self.only_one_near(stamp, others)
+        elif stamp - self.lost_since >= self._relock_s:  # the person is the one in front of the robot
+            best = self._ahead(others, only=True)
             if best is not None:  # where they are now is learnt afresh
                 self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
+        else:
+            best = None
         if best is not None:
             self.lost_since = None
             self.events.append(f"re-acquired {self.target}")

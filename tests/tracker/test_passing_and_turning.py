@@ -91,6 +91,20 @@ def test_a_lost_person_is_the_one_track_in_front_when_nobody_is_where_they_shoul
     assert sel.lost_since is None and sel.expected(1.3) is None  # their place is learnt afresh from that track
 
 
+def test_a_lost_person_followed_automatically_is_not_handed_to_whoever_is_where_they_should_be():
+    sel = TargetSelector("auto")
+    sel.target = 1
+    sel.seen(0.0, np.array([1.0, 2.5]))  # beside the robot, out of the lock zone ahead
+    sel.lost(0.2)
+    where_expected = np.array([1.1, 2.6])  # within reach, but off to the side: more often a passer-by
+    assert sel.reacquire(1.3, {8: where_expected}) is None
+    assert sel.reacquire(1.4, {8: where_expected, 7: np.array([2.5, 0.0])}) == 7  # the one in front
+    given = TargetSelector(1)  # an id the user chose: the one track within reach takes it
+    given.seen(0.0, np.array([1.0, 2.5]))
+    given.lost(0.2)
+    assert given.reacquire(0.5, {8: where_expected}) == 8
+
+
 def test_a_lost_person_is_not_guessed_among_several_in_front():
     sel = TargetSelector("auto")
     sel.target = 1

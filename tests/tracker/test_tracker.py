@@ -29,7 +29,10 @@ def run_scene(name, follow=None, config=None, **overrides):
         for t, (x, y) in zip(tracks, tracks_in_sensor_frame(tracks, pose)):
             rows.append((i, t.track_id, x, y))
             if t.target:
-                targets.append((i, t.track_id))
+                tr = st.truth
+                near = tr.person_id[tr.visible][np.argmin(np.hypot(*(tr.torso_sensor[tr.visible] - (x, y)).T))] \
+                    if tr.visible.any() else None
+                targets.append((i, t.track_id, near))  # scan, track id, the person nearest the target
         tr = st.truth
         gt += [(i, p, x, y) for p, (x, y) in zip(tr.person_id[tr.visible], tr.torso_sensor[tr.visible])]
     g, r = np.array(gt).reshape(-1, 4), np.array(rows).reshape(-1, 4)
@@ -59,8 +62,10 @@ def test_occlusion_keeps_the_hidden_person():
 
 def test_following_keeps_one_target_id():
     _, targets, trk = run_scene("crossing", follow="auto")
-    ids = {tid for _, tid in targets}
-    assert len(ids) == 1 and len(targets) > 150, (ids, len(targets))
+    ids, people = {tid for _, tid, _ in targets}, {p for _, _, p in targets}
+    # one id, always on the person first locked: where the two cross, the target is lost for
+    # about a second rather than given to whoever is near, then re-locked in front
+    assert len(ids) == 1 and len(people) == 1 and len(targets) > 130, (ids, people, len(targets))
     assert trk.selector.events[0].startswith("target ")
 
 
