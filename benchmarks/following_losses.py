@@ -7,8 +7,9 @@ Usage::
 Runs the default tracker with ``--follow auto`` on one simulated following run and sorts
 every scan where the person is visible, after the first lock, into: the target is on them
 (within 0.75 m, sensor frame); on someone or something else; no target while a reported
-track is on them (the tracker has them, the target model gave the id to no one: with the
-person lost, how many reported tracks lay within the reach where they were looked for);
+track is on them (the tracker has them, the target model gave the id to no one: lost for
+less than ``relock_s``, or after it, how many reported tracks lay in the zone ahead where
+the person is looked for: with two or more the id goes to none);
 no target while only an unreported track is on them; no target and no track near them.
 The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
 """
@@ -48,13 +49,15 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
             out["target on the person" if dist[target] <= NEAR_M else "target on someone or something else"] += 1
             continue
         if any(d <= NEAR_M for d in dist.values()):
-            exp = sel.expected(record.scan.stamp)
-            if sel.target is None or sel.lost_since is None or exp is None:
-                why = "no person being looked for"
+            stamp = record.scan.stamp
+            if sel.target is None or sel.lost_since is None:
+                why = "no person being looked for (given up, and they are not ahead)"
+            elif stamp - sel.lost_since < sel.relock_s:
+                why = f"lost for less than {sel.relock_s:g} s"
             else:
-                near = sum(float(np.hypot(*(q - exp[0]))) <= exp[1] for q in here.values())
-                why = "they were not within reach" if near == 0 else \
-                    f"{min(near, 3)}{'+' if near >= 3 else ''} reported tracks within reach"
+                ahead = len(sel.in_front(here))
+                why = "they are not in the zone ahead" if ahead == 0 else \
+                    f"{min(ahead, 3)}{'+' if ahead >= 3 else ''} reported tracks in the zone ahead"
             out[f"no target, a reported track on them: {why}"] += 1
         elif any(float(np.hypot(*(q - truth.torso_sensor[k[0]]))) <= NEAR_M
                  for q in tracks_in_sensor_frame([u.report() for u in tracker._tracks], tracker.last.pose)):

@@ -65,7 +65,7 @@ class TargetSelector:
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
         self._ahead_rad, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
         self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
-        self._relock_s = relock_s
+        self.relock_s = relock_s
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
         self._v = np.zeros(2)  # ... its rate of change (m/s) ...
@@ -144,7 +144,7 @@ class TargetSelector:
             return None
         if self.mode != "auto":  # the id goes to the one track within reach of where they should be
             best = self.only_one_near(stamp, others)
-        elif stamp - self.lost_since >= self._relock_s:  # the person is the one in front of the robot
+        elif stamp - self.lost_since >= self.relock_s:  # the person is the one in front of the robot
             best = self._ahead(others, only=True)
             if best is not None:  # where they are now is learnt afresh
                 self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
@@ -155,17 +155,17 @@ class TargetSelector:
             self.events.append(f"re-acquired {self.target}")
         return best
 
+    def in_front(self, tracks: dict[int, np.ndarray]) -> list[int]:
+        """The tracks (id → sensor-frame place, m) in the follow zone ahead, closest first."""
+        ahead = [(math.hypot(x, y), tid) for tid, (x, y) in tracks.items()
+                 if abs(math.atan2(y, x)) <= self._ahead_rad and math.hypot(x, y) <= self._lock_range]
+        return [tid for _, tid in sorted(ahead, key=lambda rt: rt[0])]
+
     def _ahead(self, tracks: dict[int, np.ndarray], only: bool = False) -> int | None:
         """The closest track (id → sensor-frame place, m) in the follow zone ahead (with
         ``only``, the one track there), or None."""
-        best, best_r, n = None, math.inf, 0
-        for tid, (x, y) in tracks.items():
-            r, bearing = math.hypot(x, y), math.atan2(y, x)
-            if abs(bearing) <= self._ahead_rad and r <= self._lock_range:
-                n += 1
-                if r < best_r:
-                    best, best_r = tid, r
-        return None if only and n > 1 else best
+        ahead = self.in_front(tracks)
+        return None if not ahead or (only and len(ahead) > 1) else ahead[0]
 
     def choose(self, reported: dict[int, np.ndarray]) -> int | None:
         """The target id now, given reported tracks (id → sensor-frame place, m)."""
