@@ -13,10 +13,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from people_tracker.detection.deskew import deskew, sweep_duration
 from people_tracker.detection.icp import IcpParams, MatchResult, ReferenceScan, match
+from people_tracker.detection.kdtree import PointTree
 from people_tracker.models.pose import Pose2D, interpolate_pose, pairwise_distances
 from people_tracker.models.scan import Scan
 
@@ -52,7 +52,7 @@ class Alignment:
         The scan-to-scan match (None for the first scan or with matching disabled).
     prior : str
         ``odometry`` or ``prediction``.
-    tree : cKDTree or None
+    tree : PointTree or None
         KD-tree of the de-skewed scan's valid readings (sensor frame), for the detector.
     """
 
@@ -60,7 +60,7 @@ class Alignment:
     pose: Pose2D
     match: MatchResult | None
     prior: str
-    tree: cKDTree | None = None
+    tree: PointTree | None = None
 
 
 def _scale_motion(motion: Pose2D, fraction: float) -> Pose2D:
@@ -154,7 +154,7 @@ class ScanAligner:
             self._world = odom
         if dt is not None and dt > 0 and (result is None or result.ok or kind == "odometry"):
             self._velocity = (rel, dt)
-        tree = cKDTree(points)
+        tree = PointTree(points)
         self._ref = ReferenceScan(points, p.icp, tree) if p.enabled else None
         self._prev_stamp, self._prev_odom = scan.stamp, odom
         return Alignment(scan, self._world, result, kind, tree)

@@ -4,11 +4,11 @@ within Δd_c of it."""
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
+from people_tracker.detection.kdtree import PointTree
 
 
-def closest_point_static(tree_c: cKDTree, points_p_in_c: np.ndarray, thr_p: np.ndarray,
-                         tree_p: cKDTree, points_c_in_p: np.ndarray, thr_c: np.ndarray
+def closest_point_static(tree_c: PointTree, points_p_in_c: np.ndarray, thr_p: np.ndarray,
+                         tree_p: PointTree, points_c_in_p: np.ndarray, thr_c: np.ndarray
                          ) -> tuple[np.ndarray, np.ndarray]:
     """Which readings of each scan have a reading of the other scan within their threshold.
 
@@ -18,13 +18,13 @@ def closest_point_static(tree_c: cKDTree, points_p_in_c: np.ndarray, thr_p: np.n
 
     Parameters
     ----------
-    tree_c : cKDTree
+    tree_c : PointTree
         The current scan's valid readings, current sensor frame.
     points_p_in_c : ndarray, shape (m, 2)
         The previous scan's valid readings in the current sensor frame, metres.
     thr_p : ndarray, shape (m,)
         Δd_c of each previous reading, metres.
-    tree_p : cKDTree
+    tree_p : PointTree
         The previous scan's valid readings, previous sensor frame.
     points_c_in_p : ndarray, shape (n, 2)
         The current scan's valid readings in the previous sensor frame, metres.
@@ -40,7 +40,7 @@ def closest_point_static(tree_c: cKDTree, points_p_in_c: np.ndarray, thr_p: np.n
     if n == 0 or m == 0:
         return np.zeros(n, dtype=bool), np.zeros(m, dtype=bool)
     # distances beyond the largest threshold come back as inf: the search stops early
-    d_c, _ = tree_p.query(points_c_in_p, k=1, distance_upper_bound=float(thr_c.max()))
-    d_p, _ = tree_c.query(points_p_in_c, k=1, distance_upper_bound=float(thr_p.max()))
+    d_c, _ = tree_p.query(points_c_in_p, float(thr_c.max()))
+    d_p, _ = tree_c.query(points_p_in_c, float(thr_p.max()))
     return d_c < thr_c, d_p < thr_p
 

@@ -11,9 +11,9 @@ from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from people_tracker.detection.closest import closest_point_static
+from people_tracker.detection.kdtree import PointTree
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
 from people_tracker.detection.objects import MovingObject, describe
 from people_tracker.detection.recover import isolated_occluded, recover_moving
@@ -115,16 +115,16 @@ class Detection:
 class _Past:
     scan: Scan
     pose: Pose2D | None
-    tree: cKDTree  # the valid readings, in the scan's own sensor frame
+    tree: PointTree  # the valid readings, in the scan's own sensor frame
     moving: np.ndarray | None = None  # per beam: labelled moving when it was the current scan
 
 
-def _tree(scan: Scan) -> cKDTree:
-    return cKDTree(scan.valid_points)
+def _tree(scan: Scan) -> PointTree:
+    return PointTree(scan.valid_points)
 
 
 def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
-               tree_c: cKDTree | None = None, tree_p: cKDTree | None = None) -> np.ndarray:
+               tree_c: PointTree | None = None, tree_p: PointTree | None = None) -> np.ndarray:
     """Labels of the current scan's readings from one comparison with an earlier scan.
 
     ``rel`` is the earlier sensor pose seen from the current one (current_T_previous);
@@ -254,7 +254,7 @@ class MovingObjectDetector:
         seen = np.zeros(len(q), dtype=np.int64)
         for past in memory:
             rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
-            d, _ = past.tree.query(rel.transform_points(q), distance_upper_bound=float(thr.max()))
+            d, _ = past.tree.query(rel.transform_points(q), float(thr.max()))
             seen += d <= thr
         share = _share_per_span(seen >= p.static_memory_min_scans, [spans[k] for k in test])
         keep[test[share >= p.static_memory_share]] = False
@@ -272,7 +272,7 @@ class MovingObjectDetector:
             if past.pose is None:
                 return np.zeros(len(spans), dtype=bool)
             shift = np.hypot(*(past.pose.between(pose).transform_points(q) - q).T)
-            d, _ = past.tree.query(q, distance_upper_bound=float(thr.max()))
+            d, _ = past.tree.query(q, float(thr.max()))
             rigid &= (d <= thr) & (shift > 2.0 * thr)
         return _share_per_span(rigid, spans) >= 0.5
 
@@ -290,7 +290,7 @@ class MovingObjectDetector:
         return chosen
 
     def detect(self, scan: Scan, pose: Pose2D | None = None, people: np.ndarray | None = None,
-               tree: cKDTree | None = None) -> Detection:
+               tree: PointTree | None = None) -> Detection:
         """Labels and moving objects of ``scan``.
 
         Parameters
@@ -301,7 +301,7 @@ class MovingObjectDetector:
         people : ndarray, shape (k, 2), optional
             Tracked people in this scan's sensor frame, metres: the static-memory test
             leaves objects near them alone.
-        tree : cKDTree, optional
+        tree : PointTree, optional
             KD-tree of ``scan.valid_points`` when the caller has one (the aligner's).
         """
         p = self.params

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg.lapack import dsyev
-from scipy.spatial import cKDTree
 
+from people_tracker.detection.kdtree import PointTree
 from people_tracker.models.pose import Pose2D, wrap_angle
 
 
@@ -130,12 +130,12 @@ class ReferenceScan:
     so it is built once a scan).
     """
 
-    def __init__(self, points: np.ndarray, params: IcpParams, tree: cKDTree | None = None) -> None:
+    def __init__(self, points: np.ndarray, params: IcpParams, tree: PointTree | None = None) -> None:
         self.points = points
         self.normals = line_normals(points, params.normal_max_gap_m)
         self.usable = np.isfinite(self.normals[:, 0])
         self.n_usable = int(self.usable.sum())
-        self.tree = (tree if tree is not None else cKDTree(points)) if self.n_usable else None
+        self.tree = (tree if tree is not None else PointTree(points)) if self.n_usable else None
 
 
 def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: IcpParams,
@@ -179,7 +179,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
     for it in range(1, params.max_iterations + 1):
         c, s = math.cos(th), math.sin(th)
         p = src @ np.array([[c, s], [-s, c]]) + (x, y)  # R p + t, in the reference frame
-        dist, j = reference.tree.query(p, k=1, distance_upper_bound=gate)
+        dist, j = reference.tree.query(p, gate)
         found = np.isfinite(dist)
         found[found] = reference.usable[j[found]]  # a partner without a normal gives no line
         if found.sum() < params.min_pairs:

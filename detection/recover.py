@@ -20,14 +20,27 @@ def join(runs: list[Segment], into: int, source: int, points: np.ndarray, join_t
     end) is refused. ``runs`` is edited in place; returns whether anything joined.
     """
     joined_any = False
+    if len(runs) < 2:
+        return joined_any
+    # a join keeps the outer ends, so the ends facing each other across the gap before a
+    # run stay the same whatever is joined: every gap and its threshold is known up front,
+    # keyed by the start of the run after the gap
+    end_a = np.array([r.stop - 1 for r in runs[:-1]])
+    end_b = np.array([r.start for r in runs[1:]])
+    step = points[end_b] - points[end_a]
+    gap_m = np.hypot(step[:, 0], step[:, 1])
+    keys = end_b.tolist()
+    gaps = dict(zip(keys, gap_m.tolist()))
+    close = dict(zip(keys, (gap_m < np.maximum(join_threshold[end_a], join_threshold[end_b])).tolist()))
+    pair = {(into, source), (source, into)}
     while True:
         best, best_gap = -1, np.inf
         for i in range(len(runs) - 1):
             a, b = runs[i], runs[i + 1]  # a precedes b in beam order
-            if {a.label, b.label} != {into, source}:
+            if (a.label, b.label) not in pair or not close[b.start]:
                 continue
-            gap = np.hypot(*(points[b.start] - points[a.stop - 1]))
-            if gap >= max(join_threshold[a.stop - 1], join_threshold[b.start]) or gap >= best_gap:
+            gap = gaps[b.start]
+            if gap >= best_gap:
                 continue
             if np.hypot(*(points[b.stop - 1] - points[a.start])) > max_extent:
                 continue

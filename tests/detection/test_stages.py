@@ -7,6 +7,7 @@ import pytest
 
 from people_tracker.detection.closest import closest_point_static
 from people_tracker.detection.detector import DetectorParams, MovingObjectDetector, combine, label_pair
+from people_tracker.detection.kdtree import BACKENDS, PointTree
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
 from people_tracker.detection.objects import describe, recovered_name
 from people_tracker.detection.recover import join, recover_moving
@@ -23,12 +24,12 @@ def test_threshold_grows_with_range_and_resolution_and_has_a_floor():
     assert thr[2] == pytest.approx(2 * thr[1]) and thr[1] == pytest.approx(4 * math.tan(math.radians(0.25)) * 2)
 
 
-def test_closest_points_are_static_both_ways():
-    from scipy.spatial import cKDTree
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_closest_points_are_static_both_ways(backend):
     c = np.array([[1.0, 0.0], [2.0, 0.0], [5.0, 5.0]])
     p = np.array([[1.01, 0.0], [2.2, 0.0]])
     # both scans in one frame here: each tree queried with the other scan's points
-    sc, sp = closest_point_static(cKDTree(c), p, np.full(2, 0.05), cKDTree(p), c, np.full(3, 0.05))
+    sc, sp = closest_point_static(PointTree(c, backend), p, np.full(2, 0.05), PointTree(p, backend), c, np.full(3, 0.05))
     assert sc.tolist() == [True, False, False] and sp.tolist() == [True, False]
 
 

@@ -1,0 +1,61 @@
+"""The nearest-neighbour search gives the same answers from either library."""
+
+from itertools import islice
+
+import numpy as np
+import pytest
+
+from people_tracker.detection import kdtree
+from people_tracker.detection.kdtree import PointTree
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.io.recording import Recording
+from people_tracker.tracker.people_tracker import PeopleTracker
+
+needs_both = pytest.mark.skipif(len(kdtree.BACKENDS) < 2, reason="pykdtree is not installed: only scipy's tree to compare")
+
+
+def test_an_empty_tree_finds_nothing():
+    d, i = PointTree(np.zeros((0, 2))).query(np.array([[1.0, 2.0]]), 5.0)
+    assert d.tolist() == [np.inf] and i.tolist() == [0]
+
+
+def test_the_bound_is_exclusive_and_a_miss_points_past_the_end():
+    for backend in kdtree.BACKENDS:
+        tree = PointTree(np.array([[0.0, 0.0], [1.0, 0.0]]), backend)
+        d, i = tree.query(np.array([[0.5, 0.0], [0.9, 0.0]]), 0.5)
+        assert d[0] == np.inf and i[0] == 2 and d[1] == pytest.approx(0.1) and i[1] == 1
+
+
+def test_an_uninstalled_backend_is_one_clear_error():
+    with pytest.raises(ValueError, match="not installed"):
+        PointTree(np.zeros((3, 2)), "flann")
+
+
+def _scans(bag, n):
+    cfg = load_config()
+    with Recording(bag, None, cfg.odometry) as rec:
+        return cfg, [(r.scan, r.pose, r.pose_last_beam) for r in islice(rec.scans(), n) if r.scan is not None]
+
+
+@needs_both
+def test_both_libraries_agree_on_real_scans(moving_bag):
+    _, scans = _scans(moving_bag, 60)
+    for (a, _, _), (b, _, _) in zip(scans, scans[5:]):
+        ref, query = a.valid_points, b.valid_points + 0.01
+        for bound in (0.05, 0.3, np.inf):
+            fast = PointTree(ref, "pykdtree").query(query, bound)
+            slow = PointTree(ref, "scipy").query(query, bound)
+            np.testing.assert_array_equal(fast[0], slow[0])
+            np.testing.assert_array_equal(fast[1], slow[1])
+
+
+@needs_both
+def test_the_tracker_reports_the_same_people_with_either_library(moving_bag, monkeypatch):
+    cfg, scans = _scans(moving_bag, 300)
+    runs = []
+    for backends in (("pykdtree", "scipy"), ("scipy",)):
+        monkeypatch.setattr(kdtree, "BACKENDS", backends)
+        tracker = PeopleTracker.from_config(cfg)
+        runs.append([[(t.track_id, t.x, t.y, t.status) for t in tracker.step(*s)] for s in scans])
+    assert sum(map(len, runs[0])) > 50  # people were reported: the comparison means something
+    assert runs[0] == runs[1]
