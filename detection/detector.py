@@ -15,7 +15,7 @@ import numpy as np
 from people_tracker.detection.closest import closest_point_static
 from people_tracker.detection.kdtree import PointTree
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
-from people_tracker.detection.objects import MovingObject, describe
+from people_tracker.detection.objects import MovingObject, describe_all
 from people_tracker.detection.recover import isolated_occluded, recover_moving
 from people_tracker.detection.scan_lines import bin_to_beams, scan_line_labels
 from people_tracker.detection.segments import split_runs
@@ -336,10 +336,10 @@ class MovingObjectDetector:
         keep = self._static_memory(scan, pose, [(seg.start, seg.stop) for seg in found], pts,
                                    scan.ranges[valid], people)
         # 5. position and box of each object big enough
-        objects = []
-        for seg in (seg for seg, k in zip(found, keep) if k):
-            objects.append(describe(self._next_id, valid[seg.start:seg.stop], pts[seg.start:seg.stop], seg.sets))
-            self._next_id += 1
+        kept = [seg for seg, k in zip(found, keep) if k]
+        objects = describe_all(self._next_id, [valid[seg.start:seg.stop] for seg in kept],
+                               [pts[seg.start:seg.stop] for seg in kept], [seg.sets for seg in kept])
+        self._next_id += len(kept)
         return Detection(labels, objects, tuple(scan.stamp - e.scan.stamp for e in earlier))
 
 

@@ -62,14 +62,29 @@ def recovered_name(sets: tuple[int, ...]) -> str:
 
 def describe(object_id: int, beams: np.ndarray, points: np.ndarray, sets: tuple[int, ...]) -> MovingObject:
     """Convex-hull centroid and minimum rotated rectangle of an object's readings."""
-    cloud = shapely.multipoints(points)
-    hull = shapely.convex_hull(cloud)
-    centroid = shapely.centroid(hull)
-    rect = shapely.minimum_rotated_rectangle(cloud)
-    if isinstance(rect, shapely.Polygon) and not rect.is_empty:
-        c = np.asarray(rect.exterior.coords)[:3]
-        sides = sorted([float(np.hypot(*(c[1] - c[0]))), float(np.hypot(*(c[2] - c[1])))])
-    else:  # collinear or a single point: a line's length, no width
-        sides = [0.0, float(rect.length)]
-    return MovingObject(object_id, beams, points, float(centroid.x), float(centroid.y), sides[0], sides[1],
-                        recovered_name(sets))
+    return describe_all(object_id, [beams], [points], [sets])[0]
+
+
+def describe_all(first_id: int, beams: list[np.ndarray], points: list[np.ndarray],
+                 sets: list[tuple[int, ...]]) -> list[MovingObject]:
+    """:func:`describe` for many objects at once (ids ``first_id``, ``first_id + 1``, ...): one
+    call of each geometry operation over all of them, the same geometry as one by one."""
+    if not points:
+        return []
+    counts = [len(p) for p in points]
+    clouds = shapely.multipoints(np.concatenate(points), indices=np.repeat(np.arange(len(points)), counts))
+    centroids = shapely.centroid(shapely.convex_hull(clouds))
+    cx, cy = shapely.get_x(centroids), shapely.get_y(centroids)
+    rects = shapely.minimum_rotated_rectangle(clouds)
+    # collinear or a single point: a line (or point) with a length and no width
+    width, length = np.zeros(len(points)), shapely.length(rects)
+    box = (shapely.get_type_id(rects) == shapely.GeometryType.POLYGON) & ~shapely.is_empty(rects)
+    if box.any():
+        coords, which = shapely.get_coordinates(rects[box], return_index=True)
+        first = np.flatnonzero(np.r_[True, which[1:] != which[:-1]])  # each rectangle's first corner
+        c0, c1, c2 = coords[first], coords[first + 1], coords[first + 2]
+        side_a = np.hypot(c1[:, 0] - c0[:, 0], c1[:, 1] - c0[:, 1])
+        side_b = np.hypot(c2[:, 0] - c1[:, 0], c2[:, 1] - c1[:, 1])
+        width[box], length[box] = np.minimum(side_a, side_b), np.maximum(side_a, side_b)
+    return [MovingObject(first_id + k, beams[k], points[k], float(cx[k]), float(cy[k]), float(width[k]),
+                         float(length[k]), recovered_name(sets[k])) for k in range(len(points))]
