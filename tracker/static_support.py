@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from people_tracker.detection.segments import split_runs
+from people_tracker.detection.segments import run_bounds
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
@@ -55,15 +55,13 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
     valid = np.flatnonzero(scan.valid)
     pts = scan.points[valid]
     gap = range_threshold(scan.ranges[valid], scan.resolution, k_segment, segment_floor_m)
-    runs = split_runs(np.zeros(len(valid), dtype=np.int8), pts, gap)
-    seg_of = np.empty(len(valid), dtype=np.int64)
-    for i, r in enumerate(runs):
-        seg_of[r.start:r.stop] = i
+    bounds = run_bounds(pts, gap)  # the scan's segments, any label
+    seg_of = np.repeat(np.arange(len(bounds) - 1), np.diff(bounds))
     pred_sensor = pose.inverse().transform_points(predictions_world)
     d = pairwise_distances(pred_sensor, pts)
     free = np.ones(len(valid), dtype=bool) if explained is None else ~explained[valid]
     d[:, ~free] = np.inf
-    chosen = np.zeros(len(runs), dtype=bool)
+    chosen = np.zeros(len(bounds) - 1, dtype=bool)
     for t in range(len(pred_sensor)):
         near = seg_of[d[t] <= radius_m]
         if len(near) == 0:
