@@ -72,7 +72,7 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
     # per-beam sensor pose relative to the first beam: linear in translation and heading
     yaw = frac * motion.yaw
     tx, ty = frac * motion.x, frac * motion.y
-    valid = np.flatnonzero(scan.valid)
+    valid = scan.valid_index
     r = scan.ranges[valid]
     a = scan.angles[valid] + yaw[valid]
     # p' = t_i + R(yaw_i) p_i

@@ -131,8 +131,8 @@ def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
     ``tree_c``/``tree_p`` are the scans' KD-trees when the caller keeps them.
     """
     labels = np.zeros(scan.n_beams, dtype=np.int8)  # INVALID
-    valid_c = np.flatnonzero(scan.valid)
-    pts_c = scan.points[valid_c]
+    valid_c = scan.valid_index
+    pts_c = scan.valid_points
     r_c = scan.ranges[valid_c]
     pts_p = rel.transform_points(prev.valid_points)  # previous readings in the current frame
     r_p = np.hypot(pts_p[:, 0], pts_p[:, 1])
@@ -320,8 +320,8 @@ class MovingObjectDetector:
         labels = combine(pairs)
         current.moving = labels == MOVING
         # 3. segments of each set, over the valid readings in beam order
-        valid = np.flatnonzero(scan.valid)
-        pts = scan.points[valid]
+        valid = scan.valid_index
+        pts = scan.valid_points
         gap = range_threshold(scan.ranges[valid], scan.resolution, p.k_segment, p.segment_floor_m)
         runs = split_runs(labels[valid], pts, gap)
         # 4. Algorithms 2 and 3: recover whole objects

@@ -95,10 +95,10 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     max_width_m : float
         Wider runs (walls, furniture sides) are no candidates.
     """
-    beams = np.flatnonzero(scan.valid)
+    beams = scan.valid_index
     if len(beams) < min_points:
         return _empty()
-    pts = scan.points[beams]
+    pts = scan.valid_points
     r = scan.ranges[beams]
     res = scan.resolution
     step = np.hypot(*np.diff(pts, axis=0).T)

@@ -4,12 +4,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 
 def wrap_angle(angle):
     """Wrap an angle (or array of angles) in radians to [-pi, pi)."""
+    if type(angle) is float:  # the common scalar case, without numpy's overhead (the same arithmetic)
+        return (angle + math.pi) % (2.0 * math.pi) - math.pi
     return (np.asarray(angle) + np.pi) % (2.0 * np.pi) - np.pi
 
 
@@ -61,13 +64,18 @@ class Pose2D:
         """Relative pose self⁻¹ ∘ other: where ``other`` is, seen from ``self``."""
         return self.inverse().compose(other)
 
+    @cached_property
+    def _rotation_t(self) -> tuple[np.ndarray, np.ndarray]:
+        """Rᵀ and t as arrays, made once per pose (poses are immutable)."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return np.array([[c, -s], [s, c]]).T, np.array([self.x, self.y])
+
     def transform_points(self, points: np.ndarray) -> np.ndarray:
         """Map points (n, 2) from the child frame to the parent frame, metres."""
         pts = np.asarray(points, dtype=np.float64)
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        rot = np.array([[c, -s], [s, c]])
+        rot_t, t = self._rotation_t
         # p_parent = R p_childᵀ + t
-        return pts @ rot.T + np.array([self.x, self.y])
+        return pts @ rot_t + t
 
     def as_matrix(self) -> np.ndarray:
         """Homogeneous 3x3 matrix of this pose."""

@@ -35,17 +35,25 @@ def beam_index(bearing, angle_min: float, angle_increment: float, n_beams: int) 
     # the offset from beam 0 in the scan's own direction, wrapped to the one turn centred on
     # the middle of the view, so the blind sector behind splits evenly between the two ends
     centre = 0.5 * (n_beams - 1) * res
-    offset = (np.asarray(bearing, dtype=np.float64) - angle_min) * np.sign(angle_increment)
-    offset = np.mod(offset - centre + np.pi, TWO_PI) - np.pi + centre
-    step = np.rint(offset / res)
-    idx = np.full(step.shape, -1, dtype=np.int64)
-    inside = np.isfinite(step) & (step > -n_beams) & (step < 2 * n_beams)  # a non-finite bearing is nowhere
-    idx[inside] = step[inside]
+    offset = np.array(bearing, dtype=np.float64)  # a private copy, worked on in place
+    offset -= angle_min
+    if angle_increment < 0:
+        np.negative(offset, out=offset)
+    offset -= centre
+    offset += np.pi
+    np.mod(offset, TWO_PI, out=offset)
+    offset -= np.pi
+    offset += centre
+    offset /= res
+    step = np.rint(offset, out=offset)
     if n_beams * res >= TWO_PI - 0.5 * res:  # a full turn: the ends meet
-        idx[inside] = np.mod(idx[inside], n_beams)
+        idx = np.full(step.shape, -1, dtype=np.int64)
+        inside = np.isfinite(step) & (step > -n_beams) & (step < 2 * n_beams)  # a non-finite bearing is nowhere
+        idx[inside] = np.mod(step[inside].astype(np.int64), n_beams)
         return idx
-    idx[(idx < 0) | (idx >= n_beams)] = -1
-    return idx
+    with np.errstate(invalid="ignore"):
+        inside = (step >= 0) & (step < n_beams)  # false for nan: a non-finite bearing is nowhere
+    return np.where(inside, step, -1).astype(np.int64)
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,10 +186,20 @@ class Scan:
         xy.setflags(write=False)
         return xy
 
-    @property
+    @cached_property
+    def valid_index(self) -> np.ndarray:
+        """Beam index of each valid reading, in beam order, shape (m,) (read-only)."""
+        idx = np.flatnonzero(self.valid)
+        idx.setflags(write=False)
+        return idx
+
+    @cached_property
     def valid_points(self) -> np.ndarray:
-        """Cartesian readings of the valid beams only, sensor frame, metres, shape (m, 2)."""
-        return self.points[self.valid]
+        """Cartesian readings of the valid beams only, sensor frame, metres, shape (m, 2)
+        (read-only)."""
+        pts = self.points[self.valid_index]
+        pts.setflags(write=False)
+        return pts
 
     def beam_of(self, bearing) -> np.ndarray:
         """Beam nearest each sensor-frame bearing (radians), -1 outside the view; see :func:`beam_index`."""

@@ -52,8 +52,8 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
     out: list[np.ndarray | None] = [None] * len(predictions_world)
     if len(predictions_world) == 0 or scan.n_valid == 0:
         return out
-    valid = np.flatnonzero(scan.valid)
-    pts = scan.points[valid]
+    valid = scan.valid_index
+    pts = scan.valid_points
     gap = range_threshold(scan.ranges[valid], scan.resolution, k_segment, segment_floor_m)
     bounds = run_bounds(pts, gap)  # the scan's segments, any label
     seg_of = np.repeat(np.arange(len(bounds) - 1), np.diff(bounds))
