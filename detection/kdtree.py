@@ -4,18 +4,46 @@ Every stage asks the same question many times a scan: which reading of another s
 nearest this point, if any within a bound. The search is exact whichever library answers it:
 ``pykdtree`` (a core dependency: a compiled tree that builds about 4 times and answers a
 scan's few hundred queries about 2-3 times faster than scipy's, where the per-call overhead
-dominates) or, when it is not installed, scipy's ``cKDTree``. ``tests/detection/test_kdtree.py``
+dominates) or, when it is not installed (or was loaded with threads by someone else), scipy's
+``cKDTree``. ``tests/detection/test_kdtree.py``
 checks that both give the same answers on real scans.
 """
 
 from __future__ import annotations
 
+import os
+import sys
+
 import numpy as np
 
-try:  # pragma: no cover - which branch runs depends on the installation
-    from pykdtree.kdtree import KDTree as _PyKDTree
-except ImportError:  # pragma: no cover
-    _PyKDTree = None
+
+def _import_single_threaded():
+    """pykdtree's KDTree, its OpenMP queries held to the calling thread; None without it.
+
+    The Linux wheels bring their own copy of libgomp, which reads ``OMP_NUM_THREADS`` once,
+    when it loads. Left at its default it starts a worker per core, and between the
+    pipeline's queries (a few hundred points, every ~100 us) the workers spin waiting for the
+    next one: a whole second core kept busy, and on one core the tracker at half speed. So
+    the variable is 1 while it loads, and put back at once (nothing else sees it). A
+    pykdtree someone else loaded first keeps its threads: then scipy's tree answers instead.
+    """
+    if "pykdtree.kdtree" in sys.modules:
+        return None
+    saved = os.environ.get("OMP_NUM_THREADS")
+    os.environ["OMP_NUM_THREADS"] = "1"
+    try:
+        from pykdtree.kdtree import KDTree
+    except ImportError:  # pragma: no cover - depends on the installation
+        return None
+    finally:
+        if saved is None:
+            del os.environ["OMP_NUM_THREADS"]
+        else:
+            os.environ["OMP_NUM_THREADS"] = saved
+    return KDTree
+
+
+_PyKDTree = _import_single_threaded()
 
 BACKENDS = ("pykdtree", "scipy") if _PyKDTree is not None else ("scipy",)
 

@@ -1,5 +1,8 @@
 """The nearest-neighbour search gives the same answers from either library."""
 
+import os
+import subprocess
+import sys
 from itertools import islice
 
 import numpy as np
@@ -59,3 +62,27 @@ def test_the_tracker_reports_the_same_people_with_either_library(moving_bag, mon
         runs.append([[(t.track_id, t.x, t.y, t.status) for t in tracker.step(*s)] for s in scans])
     assert sum(map(len, runs[0])) > 50  # people were reported: the comparison means something
     assert runs[0] == runs[1]
+
+
+_THREADS = """
+import os, numpy as np
+from people_tracker.detection.kdtree import BACKENDS, PointTree
+tree = PointTree(np.random.default_rng(0).uniform(size=(500, 2)))
+before = len(os.listdir("/proc/self/task"))
+for _ in range(200):
+    tree.query(np.random.default_rng(1).uniform(size=(300, 2)), 0.1)
+print(BACKENDS[0], before, len(os.listdir("/proc/self/task")), os.environ.get("OMP_NUM_THREADS"))
+"""
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self/task") or "pykdtree" not in kdtree.BACKENDS,
+                    reason="needs Linux's /proc and pykdtree")
+@pytest.mark.parametrize("omp", [None, "2"])
+def test_queries_start_no_threads_and_leave_the_environment_alone(omp):
+    # OpenMP workers would spin between queries, keeping a second core busy
+    env = {k: v for k, v in os.environ.items() if k != "OMP_NUM_THREADS"}
+    if omp:
+        env["OMP_NUM_THREADS"] = omp
+    out = subprocess.run([sys.executable, "-c", _THREADS], env=env, capture_output=True, text=True, check=True)
+    backend, before, after, left = out.stdout.split()
+    assert backend == "pykdtree" and after == before and left == str(omp)
