@@ -78,11 +78,13 @@ print(BACKENDS[0], before, len(os.listdir("/proc/self/task")), os.environ.get("O
 @pytest.mark.skipif(not os.path.isdir("/proc/self/task") or "pykdtree" not in kdtree.BACKENDS,
                     reason="needs Linux's /proc and pykdtree")
 @pytest.mark.parametrize("omp", [None, "2"])
-def test_queries_start_no_threads_and_leave_the_environment_alone(omp):
+def test_queries_start_no_threads_and_leave_the_environment_alone(omp, tmp_path):
     # OpenMP workers would spin between queries, keeping a second core busy
     env = {k: v for k, v in os.environ.items() if k != "OMP_NUM_THREADS"}
     if omp:
         env["OMP_NUM_THREADS"] = omp
-    out = subprocess.run([sys.executable, "-c", _THREADS], env=env, capture_output=True, text=True, check=True)
+    # away from the checkout, whose people_tracker/ folder would shadow the installed package
+    out = subprocess.run([sys.executable, "-c", _THREADS], env=env, capture_output=True, text=True, check=True,
+                         cwd=tmp_path)
     backend, before, after, left = out.stdout.split()
     assert backend == "pykdtree" and after == before and left == str(omp)
