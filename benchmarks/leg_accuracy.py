@@ -21,7 +21,12 @@ fixed false rate). Printed:
 3. simulated lasers at 0.25°, 0.5° and 1° (270°, 1 cm noise): people standing and walking
    1-5 m away among chair and table legs of 1.5-3 cm radius, walls and boxes; recall of
    the legs that show two readings or more, at the full-resolution real threshold for
-   0.5 false legs per scan, and the false legs per scan there.
+   0.5 false legs per scan, and the false legs per scan there;
+4. the people of the annotated hallway recording (``general_tracking_moving_1.bag``: another
+   robot, another place, never used in fitting the model): the share of annotated
+   person-scans with a leg candidate at or above that threshold within 0.3 m of the
+   person, by range, and the widths of the candidates nearest them against the fitted
+   legs' (its people show narrower legs).
 """
 
 from __future__ import annotations
@@ -125,7 +130,50 @@ def main(argv=None) -> int:
             total += len(legs)
             false += int((~hit_c).sum())
         print(f"{res:5.2f} deg  {total:5d}  {found / max(total, 1):6.3f}  {false / len(frames):15.2f}")
+    hallway(model, threshold)
     return 0
+
+
+def hallway(model, threshold: float, near_m: float = 0.3) -> None:
+    """Print part 4 of the module docstring."""
+    from collections import defaultdict
+
+    from people_tracker.detection.leg_features import FEATURES, leg_candidates
+    from people_tracker.tracker.io.ground_truth import read_bag_ground_truth
+
+    bag = DATA / "general_tracking_moving_1.bag"
+    gt = read_bag_ground_truth(bag)
+    people = defaultdict(list)
+    for k, x, y in zip(gt.scan_index, gt.x, gt.y):
+        people[int(k)].append((x, y))
+    width = FEATURES.index("width_m")
+    bands = ((0.0, 2.0), (2.0, 4.0), (4.0, 8.0))
+    found, total, widths = np.zeros(len(bands)), np.zeros(len(bands)), []
+    for i, (_, scan) in enumerate(T.read_scans(bag)):
+        if i not in people:
+            continue
+        c = leg_candidates(scan)
+        p = model.probability(c.features)
+        for q in people[i]:
+            d = np.hypot(*(c.xy - np.array(q)).T) if len(c) else np.zeros(0)
+            b = next(j for j, (lo, hi) in enumerate(bands) if lo <= math.hypot(*q) < hi or j == len(bands) - 1)
+            total[b] += 1
+            found[b] += bool(((d <= near_m) & (p >= threshold)).any())
+            if len(d) and d.min() <= near_m:
+                widths.append(c.features[int(np.argmin(d)), width])
+    fitted = []
+    for k in (1, 2, 3):
+        for item in T.read_labelled(DATA / "training" / f"positive_{k}_extracted.bag"):
+            c = leg_candidates(item.scan)
+            fitted += list(c.features[T.match(c.xy, item.legs, 0.15)[0], width])
+    print(f"people of the annotated hallway recording (never fitted on), threshold {threshold:.3f}: "
+          f"{found.sum() / max(total.sum(), 1):.3f} of {int(total.sum())} annotated person-scans have a leg "
+          f"within {near_m} m")
+    print("  by range " + ", ".join(f"{lo:g}-{hi:g} m {f / max(n, 1):.3f} of {int(n)}"
+                                    for (lo, hi), f, n in zip(bands, found, total)))
+    w, v = np.percentile(widths, [10, 50, 90]), np.percentile(fitted, [10, 50, 90])
+    print(f"  width of the candidate nearest each person p10/p50/p90 {w[0]:.3f}/{w[1]:.3f}/{w[2]:.3f} m, "
+          f"of the fitted legs {v[0]:.3f}/{v[1]:.3f}/{v[2]:.3f} m")
 
 
 if __name__ == "__main__":
