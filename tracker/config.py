@@ -90,6 +90,8 @@ class PairingConfig:
     sigma_single_leg_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     sigma_blob_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     max_leg_radius_m: float = field(metadata=_spec(lo=0.0, hi=1.0))
+    flat_min_length_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
+    flat_max_depth_m: float = field(metadata=_spec(lo=0.0, hi=1.0))
 
     def params(self):
         from people_tracker.tracker.pairing import PairingParams

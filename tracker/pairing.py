@@ -36,6 +36,15 @@ class PairingParams:
         person-sized object.
     max_leg_radius_m : float
         Largest leg radius: see :func:`leg_centres` (0 keeps the readings' hull centroid).
+    flat_min_length_m, flat_max_depth_m : float
+        An object at least ``flat_min_length_m`` long (longer than a leg is wide) whose
+        readings all lie within ``flat_max_depth_m`` of a straight line (its bounding
+        rectangle's short side) is a flat surface, not a leg or a person: a round leg as
+        wide as that bulges several centimetres towards the laser, and two legs side by
+        side bulge twice. Walls seen at a grazing angle slide along themselves as the
+        sensor moves and are labelled moving; this keeps them from becoming people. The
+        depth must exceed a flat surface's thickness in the laser's noise for the rule to
+        act (with a noisier laser it acts less, never on people). 0 turns it off.
     """
 
     min_leg_size_m: float = 0.04
@@ -46,6 +55,8 @@ class PairingParams:
     sigma_single_leg_m: float = 0.2
     sigma_blob_m: float = 0.12
     max_leg_radius_m: float = 0.08
+    flat_min_length_m: float = 0.16
+    flat_max_depth_m: float = 0.02
 
 
 @dataclass(frozen=True, eq=False)
@@ -142,7 +153,7 @@ def nearest_pairs(xy: np.ndarray, min_separation_m: float, max_separation_m: flo
 
 
 def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: PairingParams,
-              groups: np.ndarray | None = None) -> list[PersonCandidate]:
+              groups: np.ndarray | None = None, depths: np.ndarray | None = None) -> list[PersonCandidate]:
     """Person candidates from moving objects.
 
     Parameters
@@ -156,9 +167,15 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
     groups : ndarray of int, shape (k,), optional
         Owner of each object (-1 for none, see :func:`owners`): two legs owned by two
         different people never pair, so two people passing close never pair across.
+    depths : ndarray, shape (k,), optional
+        Shortest side of each object's bounding rectangle, metres: flat objects (see
+        :class:`PairingParams`) are neither legs nor people.
     """
-    legs = np.flatnonzero((sizes >= params.min_leg_size_m) & (sizes <= params.max_leg_size_m))
-    blobs = np.flatnonzero((sizes > params.max_leg_size_m) & (sizes <= params.max_person_size_m))
+    round_ = np.ones(len(sizes), dtype=bool)
+    if depths is not None and params.flat_max_depth_m > 0:
+        round_ = ~((sizes >= params.flat_min_length_m) & (depths < params.flat_max_depth_m))
+    legs = np.flatnonzero((sizes >= params.min_leg_size_m) & (sizes <= params.max_leg_size_m) & round_)
+    blobs = np.flatnonzero((sizes > params.max_leg_size_m) & (sizes <= params.max_person_size_m) & round_)
     out = [PersonCandidate(float(xy[i, 0]), float(xy[i, 1]), params.sigma_blob_m, "blob", (ids[i],)) for i in blobs]
     allowed = None
     if groups is not None:  # never two legs that belong to two different people

@@ -319,7 +319,8 @@ class PeopleTracker:
         # person's. A person standing still owns no moving legs: those are a passer-by's.
         people = np.array([t.position for t in self._tracks if t.confirmed and not t.still]).reshape(-1, 2)
         groups = owners(xy, people, 0.5 * self.pairing.max_leg_separation_m)
-        return pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups)
+        return pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups,
+                         np.array([o.width for o in objs]))
 
     def _associate(self, candidates: list[PersonCandidate]) -> list[tuple[int, int]]:
         if not self._tracks or not candidates:

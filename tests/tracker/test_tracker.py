@@ -95,6 +95,21 @@ def test_leg_pairing():
     assert pair_legs(xy[:1], np.array([0.02]), [9], p) == []  # too thin for a leg (a post, a cable)
 
 
+def test_flat_objects_are_neither_legs_nor_people():
+    """A wall seen at a grazing angle slides along itself and is labelled moving: readings
+    20-60 cm long within 1 cm of a line are no leg (a round leg that wide bulges several
+    cm) and no person; a short run of few readings, or a bulging one, still is."""
+    p = PairingParams()
+    xy = np.array([[1.0, 0.0], [3.0, 0.0], [5.0, 0.0], [7.0, 0.0]])
+    sizes = np.array([0.25, 0.25, 0.6, 0.10])
+    depths = np.array([0.01, 0.06, 0.012, 0.005])
+    kept = sorted((c.kind, c.object_ids) for c in pair_legs(xy, sizes, [1, 2, 3, 4], p, depths=depths))
+    assert kept == [("leg", (2,)), ("leg", (4,))]
+    off = PairingParams(flat_max_depth_m=0.0)
+    assert len(pair_legs(xy, sizes, [1, 2, 3, 4], off, depths=depths)) == 4
+    assert len(pair_legs(xy, sizes, [1, 2, 3, 4], p)) == 4  # depths unknown: nothing is flat
+
+
 def new_track(x=0.0, y=0.0, params=None, standing=False, arrived=True, existence=None):
     R = np.eye(2) * 0.01
     ex = Existence(existence or ExistenceParams(), 0.0, standing, arrived, None, 0.15)
