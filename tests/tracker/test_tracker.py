@@ -97,7 +97,7 @@ def test_leg_pairing():
 
 def test_flat_objects_are_neither_legs_nor_people():
     """A wall seen at a grazing angle slides along itself and is labelled moving: readings
-    20-60 cm long within 1 cm of a line are no leg (a round leg that wide bulges several
+    20-60 cm long within about 1 cm of a line are no leg (a round leg that wide bulges several
     cm) and no person; a short run of few readings, or a bulging one, still is."""
     p = PairingParams()
     xy = np.array([[1.0, 0.0], [3.0, 0.0], [5.0, 0.0], [7.0, 0.0]])
