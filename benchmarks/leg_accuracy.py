@@ -147,7 +147,8 @@ def hallway(model, threshold: float, near_m: float = 0.3) -> None:
     for k, x, y in zip(gt.scan_index, gt.x, gt.y):
         people[int(k)].append((x, y))
     width = FEATURES.index("width_m")
-    bands = ((0.0, 2.0), (2.0, 4.0), (4.0, 8.0))
+    edges = np.array([0.0, 2.0, 4.0])  # m: range bands from each edge to the next (the last one open)
+    bands = tuple(zip(edges, [*edges[1:], 8.0]))
     found, total, widths = np.zeros(len(bands)), np.zeros(len(bands)), []
     for i, (_, scan) in enumerate(T.read_scans(bag)):
         if i not in people:
@@ -156,7 +157,7 @@ def hallway(model, threshold: float, near_m: float = 0.3) -> None:
         p = model.probability(c.features)
         for q in people[i]:
             d = np.hypot(*(c.xy - np.array(q)).T) if len(c) else np.zeros(0)
-            b = next(j for j, (lo, hi) in enumerate(bands) if lo <= math.hypot(*q) < hi or j == len(bands) - 1)
+            b = int(np.searchsorted(edges, math.hypot(*q), side="right")) - 1
             total[b] += 1
             found[b] += bool(((d <= near_m) & (p >= threshold)).any())
             if len(d) and d.min() <= near_m:

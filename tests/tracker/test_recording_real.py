@@ -138,11 +138,13 @@ def test_flat_surfaces_start_no_false_people_in_the_empty_rooms(negative_bag):
     """negative_2.bag's left laser (nobody there; a laser this rule was chosen on): walls at a
     grazing angle labelled moving are flat, and with the rule none becomes a person
     candidate, and fewer false people last 2 s than without it."""
+    from people_tracker.tracker.pairing import PairingParams
     from people_tracker.tracker.people_tracker import PeopleTracker
+
+    rule = PairingParams()  # the shipped rule defines what is flat, on and off alike
 
     def run(depth_m):
         cfg = config_from_dict({"pairing": {"flat_max_depth_m": depth_m}})
-        flat_length_m = cfg.pairing.flat_min_length_m
         tracker = PeopleTracker.from_config(cfg)
         seen, flat_used = {}, 0
         with Recording(negative_bag, "/left_scan", cfg.odometry) as rec:
@@ -150,11 +152,11 @@ def test_flat_surfaces_start_no_false_people_in_the_empty_rooms(negative_bag):
                 for t in tracker.step(r.scan, r.pose, r.pose_last_beam):
                     seen.setdefault(t.track_id, [r.scan.stamp, r.scan.stamp])[1] = r.scan.stamp
                 flat = {o.object_id for o in tracker.last.detection.objects
-                        if o.length >= flat_length_m and o.width < 0.015}
+                        if o.length >= rule.flat_min_length_m and o.width < rule.flat_max_depth_m}
                 flat_used += sum(bool(flat & set(c.object_ids)) for c in tracker.last.candidates)
         return sum(b - a >= 2.0 for a, b in seen.values()), flat_used
 
-    lasting_on, flat_on = run(0.015)
+    lasting_on, flat_on = run(rule.flat_max_depth_m)
     lasting_off, flat_off = run(0.0)
     assert flat_on == 0 and flat_off > 0
     assert lasting_on < lasting_off
