@@ -10,7 +10,10 @@ Each track carries its log-odds of existence as two terms:
   - a static update (standing leg pair, static support) of a track that walked or arrived
     (its place was seen empty before it stood there): ``+ln(present_lr)``: the person is
     still there. A track that never moved and whose place was never seen empty gains
-    nothing from staying: that is what furniture does;
+    nothing from staying: that is what furniture does. A track that had no update for
+    longer than ``report_unseen_s`` gains it again only once it has been seen moving or its
+    place has shown something at least as leg-like as the leg model's base rate: static
+    support from a wall the laser comes back to is no sign that a person is still there;
   - no update while the scan **saw through** the place (every return beyond it):
     ``+ln(seen_through_lr)`` (< 0): strong evidence of absence;
   - no update while the place was occluded, unseen, or occupied by something else: nothing
@@ -95,7 +98,8 @@ class ExistenceParams:
         deleting use the existence probability itself.
     report_unseen_s : float
         A confirmed track with no update for longer than this is kept (its id, its place,
-        its evidence) but not reported until it is seen again, s.
+        its evidence) but not reported until it is seen again, s; its static updates count
+        as presence again once one of them looks leg-like or it is seen moving.
     """
 
     prior_moving: float = 0.2
@@ -140,6 +144,9 @@ class Existence:
                  leg_probability: float | None, leg_base_rate: float) -> None:
         self.params = params
         self.base = logit(leg_base_rate)
+        self.base_rate = leg_base_rate
+        self.last_update = stamp
+        self.vouched = True
         prior = params.prior_standing if standing else params.prior_moving
         self.l_dyn = logit(prior) + (math.log(params.arrived_lr) if standing and arrived else 0.0)
         self.walked_or_arrived = arrived or not standing
@@ -185,6 +192,12 @@ class Existence:
         p = self.params
         dt = max(stamp - self.stamp, 0.0)
         self.stamp = stamp
+        if update is None:
+            self.vouched = self.vouched and stamp - self.last_update <= p.report_unseen_s
+        else:
+            self.last_update = stamp
+            if update == "moving" or leg_probability is None or leg_probability >= self.base_rate:
+                self.vouched = True
         w = min(1.0, dt / p.independent_s) if p.independent_s > 0 else 1.0
         if update == "moving":
             self.l_dyn += w * math.log(p.motion_lr)
@@ -194,7 +207,7 @@ class Existence:
                 self.l_dyn += w * math.log(p.motion_miss_lr)
             if furniture_place and (update == "static" or visibility == OCCUPIED):
                 self.l_dyn += w * math.log(p.furniture_lr)
-            elif update == "static":
+            elif update == "static" and self.vouched:
                 if self.walked_or_arrived:
                     self.l_dyn += w * math.log(p.present_lr)
             else:

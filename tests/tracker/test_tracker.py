@@ -164,6 +164,34 @@ def test_a_standing_person_out_of_sight_is_kept_and_survival_fades_them():
     assert t.reported
 
 
+def test_back_in_view_only_a_leg_like_or_moving_update_brings_presence_back():
+    """Traced on negative_2.bag /right_scan: a false track unseen for half a minute was
+    re-confirmed within 3 s by static support from a wall (leg probability 0.01)."""
+    def back(leg_probability):
+        t, R = new_track(params=TrackParams(still_after_s=0.5))
+        for k in range(1, 6):  # walks in ...
+            t.predict(0.1 * k)
+            t.update(np.array([0.1 * k, 0.0]), R, moving=True)
+            t.weigh(UNSEEN, 0.6)
+        for k in range(6, 30):  # ... stands ...
+            t.predict(0.1 * k)
+            t.update(np.array([0.5, 0.0]), R, moving=False)
+            t.weigh(OCCUPIED, 0.6)
+        for k in range(30, 330):  # ... out of view 30 s: survival alone
+            t.predict(0.1 * k)
+            t.weigh(UNSEEN, None)
+        p_back = t.existence.probability
+        for k in range(330, 360):  # static support again for 3 s
+            t.predict(0.1 * k)
+            t.update(np.array([0.5, 0.0]), R, moving=False)
+            t.weigh(OCCUPIED, leg_probability)
+        return p_back, t.existence.probability, t.reported
+    p_back, p_wall, wall_reported = back(0.01)  # below the model's base rate (0.15 here)
+    assert p_back < 0.3 and p_wall <= p_back and not wall_reported
+    _, p_legs, legs_reported = back(0.6)  # legs: the person is there again
+    assert p_legs > 0.9 and legs_reported
+
+
 def test_evidence_per_second_does_not_depend_on_the_scan_rate():
     def walk(rate_hz):
         t, R = new_track(params=TrackParams(confirm_min_travel_m=0.0))
