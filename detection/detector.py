@@ -50,11 +50,6 @@ class DetectorParams:
     isolated_o_objects
         Also take free-standing, person-sized O segments as objects moving away, whatever
         else moves (an extension of Algorithm 3; see :func:`people_tracker.detection.recover.isolated_occluded`).
-    moving_away_max_mps
-        Such an O segment is an object moving away only when an earlier scan saw something
-        in front of it, at its beams, by no more than this speed (m/s) times the time
-        between plus the segment spacing threshold: the object itself, nearer then. A table
-        leg revealed by someone passing well in front of it is not; 0 turns the test off.
     no_return_free_m
         A previous beam with no return (``inf``, REP 117) counts as a line of sight seen
         through up to this range (m; capped at range_max) in Algorithm 1, so a reading in
@@ -89,7 +84,6 @@ class DetectorParams:
     max_object_size_m: float = 1.0
     single_object_max_o: int = 1
     isolated_o_objects: bool = True
-    moving_away_max_mps: float = 2.5
     no_return_free_m: float = 0.0
     static_memory_s: tuple[float, ...] = (0.9, 1.2, 1.5)
     static_memory_k: float = 1.5
@@ -282,36 +276,6 @@ class MovingObjectDetector:
             rigid &= (d <= thr) & (shift > 2.0 * thr)
         return _share_per_span(rigid, spans) >= 0.5
 
-    def _moved_away(self, scan: Scan, pose: Pose2D | None, earlier: list[_Past], segs: list,
-                    gap: np.ndarray) -> list:
-        """The isolated O segments (runs of the valid readings) that an earlier scan saw
-        in front of themselves by no more than a walker goes in the time between: the
-        object itself, nearer then. A free-standing thing revealed by someone passing in
-        front of it (a table leg behind a walker) had its occluder farther in front."""
-        p = self.params
-        valid = scan.valid_index
-        r_c = scan.ranges[valid]
-        keep = np.zeros(len(segs), dtype=bool)
-        for past in earlier:
-            dt = scan.stamp - past.scan.stamp
-            rel = pose.between(past.pose) if pose is not None and past.pose is not None else Pose2D()
-            pts_p = rel.transform_points(past.scan.valid_points)
-            r_p = np.hypot(pts_p[:, 0], pts_p[:, 1])
-            beam_p = bin_to_beams(pts_p, scan.angle_min, scan.angle_increment, scan.n_beams)
-            reach = p.moving_away_max_mps * dt
-            for k, seg in enumerate(segs):
-                if keep[k]:
-                    continue
-                beams = valid[seg.start:seg.stop]
-                near = np.flatnonzero((beam_p >= beams.min() - 1) & (beam_p <= beams.max() + 1))
-                if not len(near):
-                    continue
-                # how far in front of the segment each earlier reading at its beams lay
-                front = np.interp(beam_p[near], beams, r_c[seg.start:seg.stop]) - r_p[near]
-                g = float(gap[seg.start:seg.stop].max())
-                keep[k] = bool(((front > 0) & (front <= reach + g)).any())
-        return [seg for seg, k in zip(segs, keep) if k]
-
     def _earlier(self, stamp: float) -> list[_Past]:
         """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""
         if not self._history:
@@ -365,11 +329,8 @@ class MovingObjectDetector:
                                p.single_object_max_o)
         if p.isolated_o_objects:  # objects moving away, whatever else moves (extends Algorithm 3)
             taken = {(r.start, r.stop) for r in found}
-            away = [r for r in isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
-                                                 p.max_object_size_m) if (r.start, r.stop) not in taken]
-            if away and p.moving_away_max_mps > 0:
-                away = self._moved_away(scan, pose, earlier, away, gap)
-            found += away
+            found += [r for r in isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
+                                                   p.max_object_size_m) if (r.start, r.stop) not in taken]
         found = [seg for seg in found if seg.size >= p.min_object_points]
         # static things that flicker are not moving (extension, see DetectorParams)
         keep = self._static_memory(scan, pose, [(seg.start, seg.stop) for seg in found], pts,

@@ -60,7 +60,6 @@ class DetectorConfig:
     max_object_size_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
     single_object_max_o: int = field(metadata=_spec(lo=0, hi=10000))
     isolated_o_objects: bool = field(metadata=_spec())
-    moving_away_max_mps: float = field(metadata=_spec(lo=0.0, hi=100.0))
     no_return_free_m: float = field(metadata=_spec(lo=0.0, hi=1000.0))
     static_memory_s: tuple = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     static_memory_k: float = field(metadata=_spec(lo=0.0, hi=1000.0))

@@ -179,34 +179,6 @@ def test_a_flickering_post_is_static_clutter_but_a_walker_is_not():
     assert counts[-1] == 1  # with the memory off the paper's detector flags it every time
 
 
-def test_a_post_revealed_by_a_passer_by_is_not_moving_away_but_a_walker_leaving_is():
-    """Traced in the simulated waiting room: thin chair legs revealed when a walker's legs
-    passed in front of them stood free in O_C and were taken for objects moving away. An
-    object moving away was nearer in the earlier scan by what it walked in between; what a
-    passer-by revealed had its occluder far in front."""
-    def scan(stamp, ranges_at):
-        s = _wall_scan(stamp)
-        r = s.ranges.copy()
-        for beams, rng in ranges_at:
-            r[beams] = rng
-        return Scan(r, s.angle_min, s.angle_increment, 0.05, 30.0, stamp=stamp)
-    post, beams = 3.0, slice(86, 95)
-
-    def objects(params, frames):
-        det = MovingObjectDetector(params)
-        return [len(det.detect(scan(0.1 * k, f)).objects) for k, f in enumerate(frames)]
-    params = DetectorParams(compare_dt_s=(0.1,), static_memory_k=0.0)
-    other = (slice(20, 27), 2.5)  # someone arriving elsewhere: M_C is not empty (no Algorithm 3)
-    # a post at 3 m; a walker steps in front of it at 2 m for a scan and is gone
-    revealed = [[(beams, post)], [(beams, 2.0)], [(beams, post), other]]
-    assert objects(params, revealed) == [0, 1, 1]
-    off = DetectorParams(compare_dt_s=(0.1,), static_memory_k=0.0, moving_away_max_mps=0.0)
-    assert objects(off, revealed) == [0, 1, 2]  # without the test: the post "moves away"
-    # someone walking straight away at 1.5 m/s: 0.15 m farther each scan, wholly in O_C
-    leaving = [[], [(beams, 2.0)], [(beams, 2.15), other], [(beams, 2.3), other]]
-    assert objects(params, leaving) == [0, 1, 2, 1]  # the walker (and the arrival while new)
-
-
 def test_static_memory_keeps_objects_near_a_tracked_person():
     params = DetectorParams(compare_dt_s=(0.1,))
     det = MovingObjectDetector(params)
