@@ -13,7 +13,8 @@ Each track carries its log-odds of existence as two terms:
     nothing from staying: that is what furniture does. A track that had no update for
     longer than ``report_unseen_s`` gains it again only once it has been seen moving or its
     place has shown something at least as leg-like as the leg model's base rate: static
-    support from a wall the laser comes back to is no sign that a person is still there;
+    support from a wall the laser comes back to is no sign that a person is still there,
+    and until then such updates count as a place occupied by something else (survival only);
   - no update while the scan **saw through** the place (every return beyond it):
     ``+ln(seen_through_lr)`` (< 0): strong evidence of absence;
   - no update while the place was occluded, unseen, or occupied by something else: nothing
@@ -145,8 +146,7 @@ class Existence:
         self.params = params
         self.base = logit(leg_base_rate)
         self.base_rate = leg_base_rate
-        self.last_update = stamp
-        self.vouched = True
+        self.vouched = True  # static updates count as presence (False after a stale spell, until leg-like or moving)
         prior = params.prior_standing if standing else params.prior_moving
         self.l_dyn = logit(prior) + (math.log(params.arrived_lr) if standing and arrived else 0.0)
         self.walked_or_arrived = arrived or not standing
@@ -170,7 +170,7 @@ class Existence:
         return float(np.interp(self.probability, p.confidence_raw, p.confidence_calibrated))
 
     def update(self, stamp: float, update: str | None, visibility: int, leg_probability: float | None,
-               furniture_place: bool = False, walking: bool = False) -> None:
+               furniture_place: bool = False, walking: bool = False, stale: bool = False) -> None:
         """Book one scan.
 
         Parameters
@@ -188,16 +188,16 @@ class Existence:
             Standing still on a place only ever seen occupied before it came.
         walking : bool
             The track walks (it is not standing still): it should be seen moving.
+        stale : bool
+            The track has had no update for longer than ``report_unseen_s``.
         """
         p = self.params
         dt = max(stamp - self.stamp, 0.0)
         self.stamp = stamp
         if update is None:
-            self.vouched = self.vouched and stamp - self.last_update <= p.report_unseen_s
-        else:
-            self.last_update = stamp
-            if update == "moving" or leg_probability is None or leg_probability >= self.base_rate:
-                self.vouched = True
+            self.vouched = self.vouched and not stale
+        elif update == "moving" or leg_probability is None or leg_probability >= self.base_rate:
+            self.vouched = True
         w = min(1.0, dt / p.independent_s) if p.independent_s > 0 else 1.0
         if update == "moving":
             self.l_dyn += w * math.log(p.motion_lr)

@@ -173,7 +173,8 @@ class TrackState:
     def weigh(self, visibility: int, leg_probability: float | None) -> None:
         """Book this scan's evidence of existence; confirm when it is strong enough."""
         self.existence.update(self.stamp, self.update_kind, visibility, leg_probability,
-                              self.still and self.place == "occupied", walking=self.moved and not self.still)
+                              self.still and self.place == "occupied", walking=self.moved and not self.still,
+                              stale=self.stale)
         if (not self.confirmed and self.existence.probability >= self.existence.params.confirm
                 and (self.born_standing or
                      np.hypot(*(self.position - self.origin)) >= self.params.confirm_min_travel_m or
@@ -181,11 +182,14 @@ class TrackState:
             self.confirmed = True
 
     @property
+    def stale(self) -> bool:
+        """No update for longer than ``existence.report_unseen_s``: kept, but not reported."""
+        return self.stamp - self.last_update > self.existence.params.report_unseen_s
+
+    @property
     def reported(self) -> bool:
         """Confirmed, likely enough, and seen lately enough to be reported."""
-        e = self.existence.params
-        return self.confirmed and self.existence.probability >= e.keep and \
-            self.stamp - self.last_update <= e.report_unseen_s
+        return self.confirmed and self.existence.probability >= self.existence.params.keep and not self.stale
 
     def dead(self) -> bool:
         """Whether this track ends now: unlikely, lost, or tentative too long."""
