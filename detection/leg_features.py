@@ -101,7 +101,8 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     pts = scan.valid_points
     r = scan.ranges[beams]
     res = scan.resolution
-    step = np.hypot(*np.diff(pts, axis=0).T)
+    d = pts[1:] - pts[:-1]
+    step = np.hypot(d[:, 0], d[:, 1])
     limit = np.maximum(gap_m, gap_beams * res * np.maximum(r[:-1], r[1:]))
     bounds = np.concatenate([[0], np.flatnonzero(step >= limit) + 1, [len(pts)]])
     run_start, run_stop = bounds[:-1], bounds[1:]
@@ -178,9 +179,10 @@ def _sides(scan: Scan, mean: np.ndarray, rng: np.ndarray, width: np.ndarray) -> 
     beam = scan.beam_of(np.concatenate([bearing - across, bearing + across], axis=1))  # (k, 2m)
     # the reading there, or the nearest real one within two beams of it (lost readings)
     shifts = np.array([0, -1, 1, -2, 2])
-    cand = np.clip(beam[:, :, None] + shifts, 0, scan.n_beams - 1)  # (k, 2m, 5)
+    cand = np.minimum(np.maximum(beam[:, :, None] + shifts, 0), scan.n_beams - 1)  # (k, 2m, 5)
     real = scan.valid[cand] & (beam[:, :, None] >= 0)
-    pick = np.take_along_axis(cand, np.argmax(real, axis=2)[:, :, None], axis=2)[:, :, 0]
+    flat = cand.reshape(-1, len(shifts))
+    pick = flat[np.arange(len(flat)), np.argmax(real, axis=2).ravel()].reshape(beam.shape)
     value = np.minimum(np.maximum(scan.ranges[pick] - rng[:, None], -1.0), NO_RETURN_M)
     value = np.where(real.any(axis=2), value, NO_RETURN_M)
     m = len(offsets)
@@ -201,10 +203,11 @@ def _beside(scan: Scan, beam: np.ndarray, side: int, end_xy: np.ndarray, end_r: 
     steps = np.arange(1, max_beams + 1)
     j = beam[:, None] + side * steps  # (k, max_beams)
     inside = (j >= 0) & (j < scan.n_beams) & (steps[None, :] <= reach[:, None])
-    jj = np.clip(j, 0, scan.n_beams - 1)
+    jj = np.minimum(np.maximum(j, 0), scan.n_beams - 1)
     real = inside & scan.valid[jj]
     found = real.any(axis=1)
     first = jj[np.arange(len(beam)), np.argmax(real, axis=1)]
     jump = np.where(found, np.minimum(np.maximum(scan.ranges[first] - end_r, -1.0), NO_RETURN_M), NO_RETURN_M)
-    gap = np.where(found, np.hypot(*(scan.points[first] - end_xy).T), NO_RETURN_M)
+    d = scan.points[first] - end_xy
+    gap = np.where(found, np.hypot(d[:, 0], d[:, 1]), NO_RETURN_M)
     return jump, np.minimum(gap, NO_RETURN_M)

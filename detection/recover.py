@@ -33,13 +33,20 @@ def join(runs: list[Segment], into: int, source: int, points: np.ndarray, join_t
     gaps = dict(zip(keys, gap_m.tolist()))
     close = dict(zip(keys, (gap_m < np.maximum(join_threshold[end_a], join_threshold[end_b])).tolist()))
     pair = {(into, source), (source, into)}
+    # only gaps under their threshold can ever join: look at those alone, in beam order (so
+    # of equal gaps the first in beam order wins, as a scan over every pair would choose)
+    candidates = [k for k in keys if close[k]]
     while True:
         best, best_gap = -1, np.inf
-        for i in range(len(runs) - 1):
-            a, b = runs[i], runs[i + 1]  # a precedes b in beam order
-            if (a.label, b.label) not in pair or not close[b.start]:
+        at = {r.start: i for i, r in enumerate(runs)}
+        for key in candidates:
+            i = at.get(key, 0) - 1  # the run before the gap; none when the gap was joined over
+            if i < 0:
                 continue
-            gap = gaps[b.start]
+            a, b = runs[i], runs[i + 1]  # a precedes b in beam order
+            if (a.label, b.label) not in pair:
+                continue
+            gap = gaps[key]
             if gap >= best_gap:
                 continue
             if np.hypot(*(points[b.stop - 1] - points[a.start])) > max_extent:
