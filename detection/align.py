@@ -88,8 +88,7 @@ class ScanAligner:
         follows stays put in the sensor frame, and would hold the match at no motion)."""
         ref = self._ref
         if ref is not None and len(mask) == len(ref.points) and mask.any():
-            ref.usable = ref.usable & ~mask
-            ref.n_usable = int(ref.usable.sum())
+            ref.exclude(mask)
 
     def _exclusion(self, points: np.ndarray, rel: Pose2D, people_world: np.ndarray | None) -> np.ndarray | None:
         """Readings near the people, whose world positions are placed with the guess ``rel``."""

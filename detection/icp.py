@@ -133,9 +133,18 @@ class ReferenceScan:
     def __init__(self, points: np.ndarray, params: IcpParams, tree: PointTree | None = None) -> None:
         self.points = points
         self.normals = line_normals(points, params.normal_max_gap_m)
-        self.usable = np.isfinite(self.normals[:, 0])
-        self.n_usable = int(self.usable.sum())
+        self._set_usable(np.isfinite(self.normals[:, 0]))
         self.tree = (tree if tree is not None else PointTree(points)) if self.n_usable else None
+
+    def _set_usable(self, usable: np.ndarray) -> None:
+        self.usable = usable
+        self.n_usable = int(usable.sum())
+        # per KD-tree answer (an index, or one past the last for none): a partner with a normal
+        self.usable_or_none = np.append(usable, False)
+
+    def exclude(self, mask: np.ndarray) -> None:
+        """Leave the readings ``mask`` marks (shape (n,)) out of matching."""
+        self._set_usable(self.usable & ~mask)
 
 
 def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: IcpParams,
@@ -179,12 +188,12 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
     for it in range(1, params.max_iterations + 1):
         c, s = math.cos(th), math.sin(th)
         p = src @ np.array([[c, s], [-s, c]]) + (x, y)  # R p + t, in the reference frame
-        dist, j = reference.tree.query(p, gate)
-        found = np.isfinite(dist)
-        found[found] = reference.usable[j[found]]  # a partner without a normal gives no line
-        if found.sum() < params.min_pairs:
+        _, j = reference.tree.query(p, gate)
+        found = reference.usable_or_none[j]  # none within the gate, or a partner without a normal: no line
+        if np.count_nonzero(found) < params.min_pairs:
             return fail("too few correspondences", it=it)
-        p, q, nq = p[found], reference.points[j[found]], reference.normals[j[found]]
+        j = j[found]
+        p, q, nq = p[found], reference.points[j], reference.normals[j]
         r = np.einsum("ij,ij->i", p - q, nq)  # point-to-line residual
         # trimmed: keep the best share of the pairs (a partition, not a sort)
         absr = np.abs(r)
@@ -199,15 +208,15 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         g = A.T @ r
         # the rotation column measured in metres at the scene's typical range, for a fair comparison
         scale = max(math.sqrt(float(np.einsum("ij,ij->", p, p)) / len(p)), 1.0)
-        d = np.array([1.0, 1.0, 1.0 / scale])
-        D = np.diag(d)
+        d = np.array([1.0, 1.0, 1.0 / scale])  # D = diag(d)
         w, V, _ = dsyev(Hm * np.outer(d, d))  # eigen-decomposition of D H D (LAPACK, no wrapper)
         cond = float(w[0] / w[-1]) if w[-1] > 0 else 0.0
         # solve in the scaled space, dropping directions the scene does not constrain
         good = w > params.degeneracy_ratio * w[-1]
         degenerate = bool((~good).any())
-        step_scaled = -(V[:, good] @ ((V[:, good].T @ (D @ g)) / w[good]))
-        dx, dy, dth = D @ step_scaled
+        Vg = V[:, good]
+        step_scaled = -(Vg @ ((Vg.T @ (d * g)) / w[good]))
+        dx, dy, dth = (d * step_scaled).tolist()
         # compose the increment on the left: T ← ΔT ∘ T
         cd, sd = math.cos(dth), math.sin(dth)
         x, y = cd * x - sd * y + dx, sd * x + cd * y + dy
