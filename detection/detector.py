@@ -271,7 +271,8 @@ class MovingObjectDetector:
         for past in memory:
             if past.pose is None:
                 return np.zeros(len(spans), dtype=bool)
-            shift = np.hypot(*(past.pose.between(pose).transform_points(q) - q).T)
+            moved = past.pose.between(pose).transform_points(q) - q
+            shift = np.hypot(moved[:, 0], moved[:, 1])
             d, _ = past.tree.query(q, float(thr.max()))
             rigid &= (d <= thr) & (shift > 2.0 * thr)
         return _share_per_span(rigid, spans) >= 0.5

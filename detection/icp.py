@@ -110,7 +110,8 @@ def line_normals(points: np.ndarray, max_gap: float, half_width: int = 2) -> np.
     normals = np.full((n, 2), np.nan)
     if n < 2 * k + 1:
         return normals
-    step_ok = np.hypot(*np.diff(points, axis=0).T) < max_gap  # (n-1,)
+    d = points[1:] - points[:-1]
+    step_ok = np.hypot(d[:, 0], d[:, 1]) < max_gap  # (n-1,)
     # every step on the span i-k .. i+k must be short: a sliding window over the steps
     bad = np.concatenate([[0], np.cumsum(~step_ok)])
     span_bad = bad[2 * k:] - bad[: n - 2 * k]  # steps i-k..i+k-1 for i = k .. n-k-1

@@ -107,7 +107,8 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     bounds = np.concatenate([[0], np.flatnonzero(step >= limit) + 1, [len(pts)]])
     run_start, run_stop = bounds[:-1], bounds[1:]
     run_n = run_stop - run_start
-    width = np.hypot(*(pts[run_stop - 1] - pts[run_start]).T)
+    chord = pts[run_stop - 1] - pts[run_start]
+    width = np.hypot(chord[:, 0], chord[:, 1])
     k = np.flatnonzero((run_n >= min_points) & (width <= max_width_m))
     if not len(k):
         return _empty()
@@ -155,8 +156,10 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     rng = np.hypot(mean[:, 0], mean[:, 1])
     centre_depth = np.where(straight, 0.0, np.hypot(mean[:, 0] + a, mean[:, 1] + b) - rng)
     s0, s1 = start, stop - 1
-    j_first, g_first = _beside(scan, first, -1, pts[s0], r[s0])
-    j_last, g_last = _beside(scan, last, +1, pts[s1], r[s1])
+    k = len(first)  # both ends of every candidate in one call: the first ends, then the last
+    jumps, gaps = _beside(scan, np.concatenate([first, last]), np.repeat([-1, 1], k), pts[np.concatenate([s0, s1])],
+                          r[np.concatenate([s0, s1])])
+    j_first, j_last, g_first, g_last = jumps[:k], jumps[k:], gaps[:k], gaps[k:]
     expected = width / np.maximum(rng * res, 1e-6) + 1.0
     features = np.column_stack([
         n / expected, width, rng, spread, radius, circle_residual, line_residual, boundary,
@@ -190,10 +193,10 @@ def _sides(scan: Scan, mean: np.ndarray, rng: np.ndarray, width: np.ndarray) -> 
     return np.column_stack([lo, hi]).reshape(len(mean), 2, m).transpose(0, 2, 1).reshape(len(mean), 2 * m)
 
 
-def _beside(scan: Scan, beam: np.ndarray, side: int, end_xy: np.ndarray, end_r: np.ndarray,
+def _beside(scan: Scan, beam: np.ndarray, side: np.ndarray, end_xy: np.ndarray, end_r: np.ndarray,
             lateral_m: float = 0.3, max_beams: int = 12) -> tuple[np.ndarray, np.ndarray]:
     """Range step and distance from each candidate end to the first reading beside it on
-    ``side`` (-1 before, +1 after in beam order), looking as far as ``lateral_m`` across at
+    its ``side`` (per end: -1 before, +1 after in beam order), looking as far as ``lateral_m`` across at
     the end's range (``max_beams`` at most): a valid reading gives its range minus the
     end's (clipped to -1..3 m) and its distance; none (no echo, however the driver says
     it, or the view's edge), 3 m and none."""
@@ -201,7 +204,7 @@ def _beside(scan: Scan, beam: np.ndarray, side: int, end_xy: np.ndarray, end_r: 
         return np.zeros(0), np.zeros(0)
     reach = np.minimum(np.maximum(np.ceil(lateral_m / np.maximum(end_r * scan.resolution, 1e-6)), 1), max_beams)
     steps = np.arange(1, max_beams + 1)
-    j = beam[:, None] + side * steps  # (k, max_beams)
+    j = beam[:, None] + side[:, None] * steps  # (k, max_beams)
     inside = (j >= 0) & (j < scan.n_beams) & (steps[None, :] <= reach[:, None])
     jj = np.minimum(np.maximum(j, 0), scan.n_beams - 1)
     real = inside & scan.valid[jj]

@@ -51,7 +51,8 @@ def run_bounds(points: np.ndarray, gap_threshold: np.ndarray, labels: np.ndarray
     Returns an int array of shape (runs + 1,), starting at 0 and ending at ``len(points)``.
     """
     n = len(points)
-    cut = np.hypot(*np.diff(points, axis=0).T) >= np.maximum(gap_threshold[:-1], gap_threshold[1:])
+    step = points[1:] - points[:-1]
+    cut = np.hypot(step[:, 0], step[:, 1]) >= np.maximum(gap_threshold[:-1], gap_threshold[1:])
     if labels is not None:
         cut |= labels[1:] != labels[:-1]
     return np.concatenate([[0], np.flatnonzero(cut) + 1, [n]])
