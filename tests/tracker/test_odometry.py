@@ -67,3 +67,60 @@ def test_tf_tree_chain_with_and_without_leading_slash():
     assert [e.child for e in chain] == ["laser", "base_link"] and tree.root("laser") == "odom"
     p = compose_chain(chain)
     assert (p.x, p.y, p.yaw) == pytest.approx((1.0, 2.5, math.pi / 2))
+
+
+def _odometry_poses_both_ways(path):
+    """(read in place, fully deserialized) pose.pose of every nav_msgs/Odometry message."""
+    from people_tracker.tracker.io.bag import ODOMETRY, open_bag, peek_odometry_pose
+
+    reader = open_bag(path)
+    try:
+        conns = [c for c in reader.connections if c.msgtype == ODOMETRY]
+        assert conns, "the recording has odometry"
+        out = []
+        for conn, _, raw in reader.messages(connections=conns):
+            p = reader.deserialize(raw, conn.msgtype).pose.pose
+            full = (p.position.x, p.position.y, p.position.z,
+                    p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w)
+            out.append((peek_odometry_pose(raw, not reader.is2), full))
+        return out
+    finally:
+        reader.close()
+
+
+@pytest.mark.parametrize("fmt", ["mcap", "sqlite3", "ros1"])
+def test_odometry_pose_read_in_place_is_the_deserialized_one(tmp_path, fmt):
+    from tests_helpers import run_cli
+
+    out = tmp_path / ("corr.bag" if fmt == "ros1" else "corr")
+    proc = run_cli("simulate", "corridor", "--output", str(out), "--duration", "2", "--format", fmt)
+    assert proc.returncode == 0, proc.stderr
+    pairs = _odometry_poses_both_ways(out)
+    assert len(pairs) > 10 and len({full for _, full in pairs}) > 10  # the robot drives: poses differ
+    assert all(fast == full for fast, full in pairs)
+
+
+def test_odometry_pose_read_in_place_on_the_real_recording(moving_bag):
+    pairs = _odometry_poses_both_ways(moving_bag)
+    assert len(pairs) == 11561 and all(fast == full for fast, full in pairs)
+
+
+def test_odometry_pose_of_bytes_too_short_is_none_not_garbage(moving_bag):
+    from people_tracker.tracker.io.bag import peek_odometry_pose
+
+    raw = bytes(_first_odometry_raw(moving_bag))
+    assert peek_odometry_pose(raw, True) is not None
+    for cut in (0, 3, 11, 20, len(raw) - 700):
+        assert peek_odometry_pose(raw[:cut], True) is None
+    assert peek_odometry_pose(b"\x00\x01", False) is None
+
+
+def _first_odometry_raw(path):
+    from people_tracker.tracker.io.bag import ODOMETRY, open_bag
+
+    reader = open_bag(path)
+    try:
+        conns = [c for c in reader.connections if c.msgtype == ODOMETRY]
+        return next(raw for _, _, raw in reader.messages(connections=conns))
+    finally:
+        reader.close()

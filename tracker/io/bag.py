@@ -100,6 +100,41 @@ def peek_stamp(raw: bytes | memoryview, ros1: bool) -> float:
     return sec + nsec * 1e-9
 
 
+_U32 = {True: struct.Struct("<I"), False: struct.Struct(">I")}
+_POSE = {True: struct.Struct("<7d"), False: struct.Struct(">7d")}
+
+
+def peek_odometry_pose(raw: bytes | memoryview, ros1: bool) -> tuple[float, ...] | None:
+    """``pose.pose`` of a serialized ``nav_msgs/Odometry``: position x, y, z and orientation
+    x, y, z, w, read in place (a full deserialization takes ~50 µs, at 100 Hz odometry a
+    noticeable share of the tracker's time); None when the bytes do not have that layout.
+
+    The message is a ``std_msgs/Header`` (stamp, ``frame_id``), ``child_frame_id``, then the
+    pose's seven float64. ROS 1 packs them; CDR aligns each value to its size, counted
+    from the end of its 4-byte encapsulation header. ``tests/tracker/test_recording_real.py``
+    checks it against the full deserialization on real and simulated recordings.
+    """
+    size = len(raw)
+    if ros1:
+        little, base, at = True, 0, 12  # seq, stamp
+    else:
+        if size < 4:
+            return None
+        little, base, at = bool(raw[1] & 1), 4, 12  # encapsulation header, stamp
+    u32 = _U32[little]
+    for _ in range(2):  # frame_id, child_frame_id: a uint32 length, then the bytes
+        if not ros1:
+            at = base + (at - base + 3) // 4 * 4
+        if at + 4 > size:
+            return None
+        at += 4 + u32.unpack_from(raw, at)[0]
+    if not ros1:
+        at = base + (at - base + 7) // 8 * 8
+    if at + 56 > size:
+        return None
+    return _POSE[little].unpack_from(raw, at)
+
+
 def stamp_seconds(stamp) -> float:
     """A ``builtin_interfaces/Time`` as seconds."""
     return stamp.sec + stamp.nanosec * 1e-9

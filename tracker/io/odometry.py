@@ -25,7 +25,8 @@ from typing import Callable
 from people_tracker.models.pose import Pose2D, interpolate_pose, yaw_from_quaternion
 from people_tracker.tracker.config import OdometryConfig
 from people_tracker.tracker.errors import InputError
-from people_tracker.tracker.io.bag import ODOMETRY, TF_MESSAGE, connections_of, peek_stamp, stamp_seconds, topics_of_type
+from people_tracker.tracker.io.bag import (ODOMETRY, TF_MESSAGE, connections_of, peek_odometry_pose, peek_stamp,
+                                          stamp_seconds, topics_of_type)
 
 log = logging.getLogger(__name__)
 
@@ -233,6 +234,10 @@ class OdomTopicSource:
         deserialize = reader.deserialize
 
         def decode(raw) -> Pose2D:
+            pose = peek_odometry_pose(raw, self._ros1)  # read in place, else deserialized
+            if pose is not None:
+                px, py, _, qx, qy, qz, qw = pose
+                return Pose2D(px, py, yaw_from_quaternion(qx, qy, qz, qw))
             msg = deserialize(raw, ODOMETRY)
             return pose_from_msg(msg.pose.pose.position, msg.pose.pose.orientation)[0]
 
