@@ -17,7 +17,8 @@ import numpy as np
 
 from people_tracker.detection.align import Alignment, AlignParams, ScanAligner
 from people_tracker.detection.detector import Detection, DetectorParams, MovingObjectDetector
-from people_tracker.detection.free_space import SEEN_THROUGH, UNSEEN, PlaceMemory, place_visibility, seen_through
+from people_tracker.detection.free_space import (OCCLUDED, SEEN_THROUGH, UNSEEN, PlaceMemory, place_visibility,
+                                                 seen_through)
 from people_tracker.detection.leg_features import LegCandidates, leg_candidates
 from people_tracker.models.leg_model import LegModel, load_leg_model
 from people_tracker.models.pose import Pose2D, pairwise_distances
@@ -119,7 +120,8 @@ class PeopleTracker:
         self.leg_model = leg_model if leg_model is not None else load_leg_model()
         self.existence = existence or ExistenceParams()
         self.places = PlaceMemory(self.existence.place_keyframe_s, self.existence.place_memory_s)
-        self._stood: list[list] = []  # where people who walked in stand still: [xy (m), last stamp (s), id, l_dyn]
+        # where people who walked in stand still: [xy (m), last stamp (s), id, l_dyn, only a guess (bool)]
+        self._stood: list[list] = []
         self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
         self._leg_scores = np.zeros(0)  # ... and their leg probabilities
         self._explained: np.ndarray | None = None  # this scan's readings taken by moving candidates given to tracks
@@ -229,12 +231,13 @@ class PeopleTracker:
         if not self._tracks:
             return
         xy = np.array([t.position for t in self._tracks])
-        best = self._best_leg(xy)
         idle = np.array([not t.updated_now for t in self._tracks])
         vis = np.full(len(xy), UNSEEN, dtype=np.int8)
         if idle.any():
             vis[idle] = place_visibility(xy[idle], scan, world, self.existence.place_radius_m,
                                          self.detector.params.no_return_free_m)
+            self._stopped_hidden(scan, world, vis)
+        best = self._best_leg(xy)
         for t in self._tracks:  # where a track came to stand still: was the place ever empty?
             if t.place is None and t.moved and t.still:
                 t.place = self._place_history(t.position, t.last_moving_update)
@@ -242,6 +245,33 @@ class PeopleTracker:
             # nothing leg-like where something person-like updated it: a shape of 0
             leg = float(b) if b == b else (0.0 if t.updated_now else None)
             t.weigh(int(v), leg)
+
+    def _stopped_hidden(self, scan: Scan, world: Pose2D, vis: np.ndarray) -> None:
+        """A reported walker coasting out of sight whose predicted place comes out into the
+        open, and is seen empty, did not walk on there: they turned, or stopped somewhere on
+        the hidden stretch of their path, from where they were last seen to the last
+        predicted place that was hidden. The stretch's middle, the best guess of where they
+        stand, goes to the memory of where people stood (if it is still hidden), with their
+        id and evidence, so they are found there again once the view clears; the track
+        itself goes on as before (a walker who turned is found by it). Every other coasting
+        track notes where its prediction is hidden."""
+        walkers = []
+        for i, t in enumerate(self._tracks):
+            if t.updated_now:
+                continue
+            if vis[i] == OCCLUDED:
+                t.hidden_position = t.position.copy()
+            elif vis[i] == SEEN_THROUGH and t.hidden_position is not None and t.reported and t.moved and not t.still:
+                walkers.append(t)
+        if not walkers:
+            return
+        middle = np.array([0.5 * (t.seen_position + t.hidden_position) for t in walkers])
+        hidden = place_visibility(middle, scan, world, self.existence.place_radius_m,
+                                  self.detector.params.no_return_free_m) == OCCLUDED
+        for t, xy, h in zip(walkers, middle, hidden):
+            if h:
+                self._stood.append([xy, scan.stamp, t.track_id, t.existence.l_dyn, True])
+            t.hidden_position = None  # once per spell out of sight
 
     def _remember_standing(self, scan: Scan, world: Pose2D) -> None:
         """Remember where reported people who walked in stand still (world frame), with their
@@ -256,16 +286,17 @@ class PeopleTracker:
             if t.reported and t.moved and t.still and t.place != PlaceMemory.OCCUPIED_ONLY:
                 for e in stood:
                     if e[2] == t.track_id or np.hypot(*(e[0] - t.position)) <= self.assoc.support_anchor_m:
-                        e[0], e[1], e[2], e[3] = t.position.copy(), stamp, t.track_id, t.existence.l_dyn
+                        e[:] = [t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False]
                         break
                 else:
-                    stood.append([t.position.copy(), stamp, t.track_id, t.existence.l_dyn])
+                    stood.append([t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False])
         self._stood = stood[-1000:]
 
     def _reacquire_standing(self, scan: Scan, world: Pose2D) -> None:
         """A person-sized object where someone stood, and no track there: that person, seen
         again after their track was lost (someone walked between, the track went with the
-        passer-by). They get their id back when it is free, and their evidence."""
+        passer-by). They get their id back when it is free, and their evidence. Where they
+        were only guessed to stand (:meth:`_stopped_hidden`), the object must look like a leg."""
         if not self._stood:
             return
         clear = self._clear_of_tracks(np.array([e[0] for e in self._stood]))
@@ -278,6 +309,12 @@ class PeopleTracker:
         for e, z in zip(lost, found):
             if z is None or np.hypot(*(z - e[0])) > self.assoc.support_anchor_m:
                 continue
+            # where they were only guessed to stand (lost out of sight), the thing found must
+            # look at least as leg-like as the leg model's base rate (as for any track back in
+            # view): clutter the view clears on is not them
+            if e[4] and not np.nan_to_num(self._best_leg(z[None]))[0] >= self.leg_model.base_rate:
+                continue
+            e[4] = False
             ex = Existence(self.existence, scan.stamp, True, True, None, self.leg_model.base_rate)
             ex.l_dyn = e[3]
             track_id = e[2] if e[2] not in used else self._next_id

@@ -96,6 +96,8 @@ class TrackState:
         self.last_update = stamp
         self.last_moving_update = stamp
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
+        self.seen_position = np.array([x, y])  # where the last update of any kind put it, m
+        self.hidden_position: np.ndarray | None = None  # the last predicted place found hidden since the last update, m
         self.origin = np.array([x, y])
         self.existence = existence
         self.confirmed = False
@@ -154,6 +156,8 @@ class TrackState:
         # y = z - H x ; S = H P Hᵀ + R ; K = P Hᵀ S⁻¹ ; x = x + K y ; P = (I - K H) P
         self.kf.update(z, R=R)
         self.last_update = self.stamp
+        self.seen_position = self.position.copy()
+        self.hidden_position = None
         if moving:
             self.moved = True
             self.last_moving_update = self.stamp

@@ -333,3 +333,54 @@ def test_a_person_held_still_is_not_pulled_away_by_a_distant_moving_candidate():
     near = PersonCandidate(0.3, 0.0, 0.1, "leg")
     assert trk._associate([far]) == []
     assert trk._associate([near]) == [(0, 0)]
+
+
+def _room_with_someone_in_front(stamp):
+    """A 270° scan (0.5°) of a wall 5 m away all round, and someone 1 m ahead across
+    bearings 5°..25°: everything behind them, out to 5 m, is hidden."""
+    angles = np.radians(np.arange(-135.0, 135.0 + 1e-9, 0.5))
+    ranges = np.full(len(angles), 5.0)
+    ranges[(angles >= np.radians(5.0)) & (angles <= np.radians(25.0))] = 1.0
+    return Scan(ranges, float(angles[0]), float(np.radians(0.5)), 0.05, 30.0, stamp)
+
+
+def test_a_walker_who_vanishes_behind_someone_is_remembered_where_they_may_stand():
+    """Traced in the waiting room (seed 23): a walker stopped right behind someone
+    standing; their track coasted on into the open beyond, was seen empty there and
+    deleted, and when the view cleared minutes later nobody looked for them where they
+    stood. The middle of the hidden stretch of their path is remembered with their id, as
+    a guess that needs something leg-like to be taken up."""
+    from people_tracker.models.pose import Pose2D
+
+    tracker = PeopleTracker.from_config(load_config())
+    t, R = new_track(x=3.0, y=0.5)  # last seen 3 m ahead, at bearing 9.5°: behind the person in front
+    t.confirmed, t.moved, t.existence.l_dyn = True, True, 3.0  # a reported walker
+    t.kf.x[:] = [3.0, 0.0, 0.5, 1.0]  # walking to +y at 1 m/s
+    tracker._tracks = [t]
+    scan = _room_with_someone_in_front(0.5)
+    for stamp in (0.5, 1.0, 2.0):  # 0.5 m on (18°: hidden), 1 m (27°: its disc partly behind them), 2 m (40°: in the open, seen empty)
+        t.predict(stamp)
+        tracker._weigh(scan, Pose2D())
+        if stamp < 2.0:
+            assert not tracker._stood and t.hidden_position is not None
+    assert len(tracker._stood) == 1
+    xy, _, track_id, l_dyn, guess = tracker._stood[0]
+    assert track_id == t.track_id and guess
+    # the middle of 3.0,0.5 (last seen) .. 3.0,1.5 (the last prediction that was hidden)
+    assert xy == pytest.approx([3.0, 1.0], abs=1e-9)
+    assert t.hidden_position is None  # once per spell out of sight
+
+
+def test_a_walker_who_walks_on_in_the_open_is_not_remembered():
+    from people_tracker.models.pose import Pose2D
+
+    tracker = PeopleTracker.from_config(load_config())
+    t, R = new_track(x=3.0, y=-1.0)  # last seen at bearing -18°: in the open
+    t.confirmed, t.moved, t.existence.l_dyn = True, True, 3.0
+    t.kf.x[:] = [3.0, 0.0, -1.0, -1.0]
+    tracker._tracks = [t]
+    scan = _room_with_someone_in_front(0.5)
+    for stamp in (0.5, 1.0):
+        t.predict(stamp)
+        tracker._weigh(scan, Pose2D())
+    assert not tracker._stood
