@@ -236,7 +236,7 @@ class PeopleTracker:
         if idle.any():
             vis[idle] = place_visibility(xy[idle], scan, world, self.existence.place_radius_m,
                                          self.detector.params.no_return_free_m)
-            self._stopped_hidden(scan, world, vis)
+            self._remember_hidden_stops(scan, world, vis)
         best = self._best_leg(xy)
         for t in self._tracks:  # where a track came to stand still: was the place ever empty?
             if t.place is None and t.moved and t.still:
@@ -246,7 +246,7 @@ class PeopleTracker:
             leg = float(b) if b == b else (0.0 if t.updated_now else None)
             t.weigh(int(v), leg)
 
-    def _stopped_hidden(self, scan: Scan, world: Pose2D, vis: np.ndarray) -> None:
+    def _remember_hidden_stops(self, scan: Scan, world: Pose2D, vis: np.ndarray) -> None:
         """A reported walker coasting out of sight whose predicted place comes out into the
         open, and is seen empty, did not walk on there: they turned, or stopped somewhere on
         the hidden stretch of their path, from where they were last seen to the last
@@ -296,7 +296,7 @@ class PeopleTracker:
         """A person-sized object where someone stood, and no track there: that person, seen
         again after their track was lost (someone walked between, the track went with the
         passer-by). They get their id back when it is free, and their evidence. Where they
-        were only guessed to stand (:meth:`_stopped_hidden`), the object must look like a leg."""
+        were only guessed to stand (:meth:`_remember_hidden_stops`), the object must look like a leg."""
         if not self._stood:
             return
         clear = self._clear_of_tracks(np.array([e[0] for e in self._stood]))
