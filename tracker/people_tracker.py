@@ -231,13 +231,13 @@ class PeopleTracker:
         if not self._tracks:
             return
         xy = np.array([t.position for t in self._tracks])
+        best = self._best_leg(xy)
         idle = np.array([not t.updated_now for t in self._tracks])
         vis = np.full(len(xy), UNSEEN, dtype=np.int8)
         if idle.any():
             vis[idle] = place_visibility(xy[idle], scan, world, self.existence.place_radius_m,
                                          self.detector.params.no_return_free_m)
             self._remember_hidden_stops(scan, world, vis)
-        best = self._best_leg(xy)
         for t in self._tracks:  # where a track came to stand still: was the place ever empty?
             if t.place is None and t.moved and t.still:
                 t.place = self._place_history(t.position, t.last_moving_update)

@@ -20,21 +20,6 @@ from people_tracker.models.scan import Scan
 from people_tracker.tracker.pairing import leg_centres
 
 
-_last_segments: list = [None, None]  # (scan, k, floor), (bounds, seg_of): the tracker asks several times a scan
-
-
-def _segments(scan: Scan, k_segment: float, segment_floor_m: float) -> tuple[np.ndarray, np.ndarray]:
-    """Bounds of the scan's segments (see :func:`run_bounds`) and the segment of each valid
-    reading; kept for the last scan asked about."""
-    key, value = _last_segments
-    if key is None or key[0] is not scan or key[1:] != (k_segment, segment_floor_m):
-        gap = range_threshold(scan.ranges[scan.valid_index], scan.resolution, k_segment, segment_floor_m)
-        bounds = run_bounds(scan.valid_points, gap)
-        value = (bounds, np.repeat(np.arange(len(bounds) - 1), np.diff(bounds)))
-        _last_segments[:] = [(scan, k_segment, segment_floor_m), value]
-    return value
-
-
 def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_segment: float,
                    segment_floor_m: float, radius_m: float, max_size_m: float,
                    min_points: int, max_leg_radius_m: float = 0.0,
@@ -69,7 +54,9 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         return out
     valid = scan.valid_index
     pts = scan.valid_points
-    bounds, seg_of = _segments(scan, k_segment, segment_floor_m)  # the scan's segments, any label
+    gap = range_threshold(scan.ranges[valid], scan.resolution, k_segment, segment_floor_m)
+    bounds = run_bounds(pts, gap)  # the scan's segments, any label
+    seg_of = np.repeat(np.arange(len(bounds) - 1), np.diff(bounds))
     pred_sensor = pose.inverse().transform_points(predictions_world)
     d = pairwise_distances(pred_sensor, pts)
     free = np.ones(len(valid), dtype=bool) if explained is None else ~explained[valid]

@@ -111,7 +111,7 @@ def peek_odometry_pose(raw: bytes | memoryview, ros1: bool) -> tuple[float, ...]
 
     The message is a ``std_msgs/Header`` (stamp, ``frame_id``), ``child_frame_id``, then the
     pose's seven float64. ROS 1 packs them; CDR aligns each value to its size, counted
-    from the end of its 4-byte encapsulation header. ``tests/tracker/test_recording_real.py``
+    from the end of its 4-byte encapsulation header. ``tests/tracker/test_odometry.py``
     checks it against the full deserialization on real and simulated recordings.
     """
     size = len(raw)
