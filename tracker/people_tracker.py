@@ -556,7 +556,9 @@ class PeopleTracker:
 
         Two people's torsos are never closer than ``tracks.min_person_separation_m``; when a
         track born beside one standing still comes that close, it is the same person twice:
-        the one that stood there longer keeps the place (with both still, the older track).
+        the one that stood there longer keeps the place (with both still, the one that moved
+        less over the last ``tracks.still_after_s``: a track that slid over from where
+        someone hidden stands goes).
         A track that started farther away than ``association.recover_radius_m`` and walks on
         (seen moving within ``tracks.still_after_s``, at ``PASSING_MPS`` or faster; passing
         in front of or behind the standing person hides one of them for a moment) is someone
@@ -579,8 +581,9 @@ class PeopleTracker:
                            and np.hypot(*walker.velocity) >= PASSING_MPS)
                 if not passing:  # born beside them (their own leg's track), or sliding onto them
                     out.add(k)
-            else:
-                out.add(idx[b] if ta.born <= tb.born else idx[a])
+            else:  # the one that moved more over the last still_after_s slid there: it goes
+                da, db = (float(np.hypot(*(t.position - t.recent_position))) for t in (ta, tb))
+                out.add(idx[b] if (da, ta.born) <= (db, tb.born) else idx[a])
         return out
 
     def _born_beside(self, t: TrackState, tracks: list[TrackState], stamp: float) -> list[TrackState]:

@@ -93,12 +93,14 @@ class TrackState:
         self.kf = kf
         self.stamp = stamp  # time of the state, s
         self.born = stamp
+        self.last_weighed = stamp
         self.last_update = stamp
         self.last_moving_update = stamp
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
         self.seen_position = np.array([x, y])  # where the last update of any kind put it, m
         self.hidden_position: np.ndarray | None = None  # the last predicted place found hidden since the last update, m
         self.origin = np.array([x, y])
+        self.recent_position = np.array([x, y])  # its position averaged over the last still_after_s, m
         self.existence = existence
         self.confirmed = False
         self.born_standing = standing
@@ -176,6 +178,9 @@ class TrackState:
 
     def weigh(self, visibility: int, leg_probability: float | None) -> None:
         """Book this scan's evidence of existence; confirm when it is strong enough."""
+        a = 1.0 - math.exp(-(self.stamp - self.last_weighed) / max(self.params.still_after_s, 1e-6))
+        self.recent_position += a * (self.position - self.recent_position)
+        self.last_weighed = self.stamp
         self.existence.update(self.stamp, self.update_kind, visibility, leg_probability,
                               self.still and self.place == "occupied", walking=self.moved and not self.still,
                               stale=self.stale)

@@ -384,3 +384,38 @@ def test_a_walker_who_walks_on_in_the_open_is_not_remembered():
         t.predict(stamp)
         tracker._weigh(scan, Pose2D())
     assert not tracker._stood
+
+
+def test_of_two_people_standing_too_close_the_track_that_slid_there_goes():
+    """Traced in the waiting room (seed 21): two people stood face to face 0.6 m apart; when
+    one of them was hidden, their track slid over onto the other, and the rule "two standing
+    tracks closer than min_person_separation_m are one person twice" deleted the other's
+    track, the younger one, so the visible person went on under the hidden one's id. The
+    track that moved over the last still_after_s is the one that slid: it goes."""
+    from people_tracker.models.pose import Pose2D
+
+    tracker = PeopleTracker.from_config(load_config())
+    sep = tracker.track_params.min_person_separation_m
+    older, _ = new_track(x=0.5, y=5.0, params=tracker.track_params, standing=True)
+    younger, _ = new_track(x=-0.1, y=5.0, params=tracker.track_params, standing=True)
+    younger.track_id = 2
+    for t in (older, younger):
+        t.confirmed = True
+    tracker._tracks = [older, younger]
+    scan = _room_with_someone_in_front(0.5)
+    for k in range(1, 31):  # 2 s standing still at 15 Hz
+        for t in (older, younger):
+            t.predict(k / 15.0)
+        tracker._weigh(scan, Pose2D())
+    assert not tracker._duplicates()
+    for k in range(31, 36):  # the older one slides 0.3 m towards the younger in a third of a second
+        older.kf.x[0] -= 0.06
+        for t in (older, younger):
+            t.predict(k / 15.0)
+        tracker._weigh(scan, Pose2D())
+    assert np.hypot(*(older.position - younger.position)) < sep
+    assert tracker._duplicates() == {0}  # the one that slid, though older
+    # neither moved: the older keeps the place, as before
+    younger.recent_position = younger.position.copy()
+    older.recent_position = older.position.copy()
+    assert tracker._duplicates() == {1}
