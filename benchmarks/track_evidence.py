@@ -72,16 +72,19 @@ def run_scene(name: str, seed: int | None, duration: float | None, people: int |
                     np.array(world, dtype=float).reshape(-1, 2), source.truths)
 
 
+def _scans_with_people(run: SceneRun):
+    """Each scan with reported rows and people in the scene: (indices of its rows, its Truth)."""
+    scan = run.rows[:, 0].astype(np.int64)
+    for k in np.unique(scan):
+        if len(run.truths[k].person_id):
+            yield np.flatnonzero(scan == k), run.truths[k]
+
+
 def nearest_person(run: SceneRun) -> tuple[np.ndarray, np.ndarray]:
     """For each reported row: the distance to the nearest person in the scene (m) and their id."""
     dist = np.full(len(run.rows), np.inf)
     who = np.full(len(run.rows), -1, dtype=np.int64)
-    scan = run.rows[:, 0].astype(np.int64)
-    for k in np.unique(scan):
-        sel = np.flatnonzero(scan == k)
-        tr = run.truths[k]
-        if len(tr.person_id) == 0:
-            continue
+    for sel, tr in _scans_with_people(run):
         d = pairwise_distances(run.world_rows[sel], tr.torso_world)
         j = d.argmin(axis=1)
         dist[sel] = d[np.arange(len(sel)), j]
@@ -97,12 +100,7 @@ def ids_per_person(run: SceneRun) -> dict[int, set[int]]:
     from scipy.optimize import linear_sum_assignment
 
     ids: dict[int, set[int]] = {}
-    scan = run.rows[:, 0].astype(np.int64)
-    for k in np.unique(scan):
-        sel = np.flatnonzero(scan == k)
-        tr = run.truths[k]
-        if len(tr.person_id) == 0:
-            continue
+    for sel, tr in _scans_with_people(run):
         d = pairwise_distances(tr.torso_world, run.world_rows[sel])
         rows, cols = linear_sum_assignment(np.where(d <= NEAR_M, d, 1e6))
         for i, j in zip(rows, cols):
