@@ -559,10 +559,11 @@ class PeopleTracker:
         the one that stood there longer keeps the place (with both still, the one that moved
         less over the last ``tracks.still_after_s``: a track that slid over from where
         someone hidden stands goes).
-        A track that started farther away than ``association.recover_radius_m`` and walks on
-        (seen moving within ``tracks.still_after_s``, at ``PASSING_MPS`` or faster; passing
-        in front of or behind the standing person hides one of them for a moment) is someone
-        passing close by, and stays."""
+        A track that started farther from them than one of their legs can be (half of
+        ``pairing.max_leg_separation_m``) and walks on (seen moving within
+        ``tracks.still_after_s``, at ``PASSING_MPS`` or faster; passing in front of or behind
+        the standing person hides one of them for a moment) is someone passing close by, and
+        stays."""
         sep = self.track_params.min_person_separation_m
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
         if len(idx) < 2 or sep <= 0:
@@ -576,10 +577,10 @@ class PeopleTracker:
                 continue
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
-                passing = (np.hypot(*(walker.origin - stander.position)) > self.assoc.recover_radius_m
+                passing = (np.hypot(*(walker.origin - stander.position)) > 0.5 * self.pairing.max_leg_separation_m
                            and walker.stamp - walker.last_moving_update <= self.track_params.still_after_s
                            and np.hypot(*walker.velocity) >= PASSING_MPS)
-                if not passing:  # born beside them (their own leg's track), or sliding onto them
+                if not passing:  # born at their leg (their own leg's track), or sliding onto them
                     out.add(k)
             else:  # the one that moved more over the last still_after_s slid there: it goes
                 da, db = (float(np.hypot(*(t.position - t.recent_position))) for t in (ta, tb))

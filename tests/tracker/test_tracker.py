@@ -419,3 +419,22 @@ def test_of_two_people_standing_too_close_the_track_that_slid_there_goes():
     younger.recent_position = younger.position.copy()
     older.recent_position = older.position.copy()
     assert tracker._duplicates() == {1}
+
+
+def test_a_walker_born_beyond_a_standing_persons_legs_passes_them_by():
+    """Traced in the waiting room (seed 23): someone walking in was first seen 0.69 m from a
+    person standing, passed within 0.3 m of them and had their track deleted as the standing
+    person's own leg's track, because it began within association.recover_radius_m (0.8 m,
+    the reach of a sharp turn). A leg is at most half a stride from its torso: a track begun
+    farther than that, walking, is a passer-by."""
+    tracker = PeopleTracker.from_config(load_config())
+    reach = 0.5 * tracker.pairing.max_leg_separation_m
+    stander, _ = new_track(x=3.75, y=1.86, params=tracker.track_params, standing=True)
+    for origin_m, kept in ((reach + 0.25, True), (reach - 0.1, False)):
+        walker, _ = new_track(x=3.75 + origin_m, y=1.86, params=tracker.track_params)
+        walker.track_id = 2
+        walker.kf.x[:] = [3.75 + 0.25, -1.0, 1.86, 0.0]  # now 0.25 m from them, walking past at 1 m/s
+        for t in (stander, walker):
+            t.confirmed = True
+        tracker._tracks = [stander, walker]
+        assert (tracker._duplicates() == set()) == kept, origin_m
