@@ -606,13 +606,14 @@ class PeopleTracker:
         return True
 
     def _set_off(self, t: TrackState, stamp: float) -> bool:
-        """Someone standing still who set off with a first step beyond reach: a confirmed
-        walking track was born beside them and their standing track has had no update
-        since. Walking away along the line of sight hides the place they left, so its
-        emptiness may never be seen."""
+        """Someone standing still who set off with a first step beyond reach: a walking
+        track was born beside them and their standing track has had no update since it was
+        confirmed (walked off; the trailing leg stays on the spot for the first step, so an
+        update or two after its birth is no sign that they stayed). Walking away along the
+        line of sight hides the place they left, so its emptiness may never be seen."""
         if not (t.confirmed and t.moved and t.still) or t.updated_now:
             return False
-        return any(u.confirmed and not u.still and u.born >= t.last_update
+        return any(u.confirmed and not u.still and u.confirmed_at is not None and u.confirmed_at >= t.last_update
                    for u in self._born_beside(t, self._tracks, stamp))
 
     def _delete(self, stamp: float) -> None:

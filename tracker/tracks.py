@@ -103,6 +103,7 @@ class TrackState:
         self.recent_position = np.array([x, y])  # its position averaged over the last still_after_s, m
         self.existence = existence
         self.confirmed = False
+        self.confirmed_at: float | None = None  # when it was confirmed (by its evidence), s
         self.born_standing = standing
         self.moved = not standing  # has a moving candidate ever updated it
         self.update_kind: str | None = "static" if standing else "moving"  # how this scan updated it
@@ -189,6 +190,7 @@ class TrackState:
                      np.hypot(*(self.position - self.origin)) >= self.params.confirm_min_travel_m or
                      self.existence.shape_p >= self.params.confirm_leg_probability)):
             self.confirmed = True
+            self.confirmed_at = self.stamp
 
     @property
     def stale(self) -> bool:

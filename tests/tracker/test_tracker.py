@@ -438,3 +438,31 @@ def test_a_walker_born_beyond_a_standing_persons_legs_passes_them_by():
             t.confirmed = True
         tracker._tracks = [stander, walker]
         assert (tracker._duplicates() == set()) == kept, origin_m
+
+
+def test_someone_who_sets_off_hands_their_id_to_their_walking_track_after_the_trailing_step():
+    """Traced in the waiting room (seed 23): a person who had stood for two minutes set off;
+    their walking track began 0.65 m from the standing one, but the trailing leg, still on
+    the spot for the first step, gave the standing track one more update after that. The
+    rule asked for no update since the walking track *began*, so the standing track
+    lingered unreported and the person walked out under a new id. Once the walking track
+    is confirmed (it has walked off), no update since then is what counts."""
+    tracker = PeopleTracker.from_config(load_config())
+    stander, _ = new_track(x=5.25, y=1.31, params=tracker.track_params, standing=True)
+    stander.confirmed, stander.moved = True, True
+    stander.last_moving_update = -10.0  # standing still for ten seconds
+    walker, _ = new_track(x=5.55, y=1.90, params=tracker.track_params)
+    walker.track_id = 2
+    walker.born = 0.0  # began at 0 s beside them
+    stander.last_update = 0.13  # the trailing leg, one scan later
+    walker.confirmed, walker.confirmed_at = True, 0.8  # walked off
+    for t in (stander, walker):
+        t.stamp = 0.93
+        t.update_kind = None
+    walker.update_kind = "moving"
+    walker.last_moving_update = 0.93
+    tracker._tracks = [stander, walker]
+    assert stander.still and not walker.still
+    assert tracker._set_off(stander, 0.93)
+    stander.last_update = 0.86  # updated after the walker was confirmed: still standing there
+    assert not tracker._set_off(stander, 0.93)
