@@ -321,7 +321,7 @@ class PeopleTracker:
             if track_id == self._next_id:
                 self._next_id += 1
             t = TrackState(track_id, float(z[0]), float(z[1]), R, scan.stamp, self.track_params, ex, standing=True)
-            t.confirmed, t.confirmed_at, t.moved, t.place = True, scan.stamp, True, PlaceMemory.UNKNOWN
+            t.confirmed, t.moved, t.place = True, True, PlaceMemory.UNKNOWN
             t.last_moving_update = t.last_update - self.track_params.still_after_s  # standing still
             self._tracks.append(t)
             used.add(track_id)
@@ -613,7 +613,7 @@ class PeopleTracker:
         line of sight hides the place they left, so its emptiness may never be seen."""
         if not (t.confirmed and t.moved and t.still) or t.updated_now:
             return False
-        return any(u.confirmed and not u.still and u.confirmed_at is not None and u.confirmed_at >= t.last_update
+        return any(u.confirmed and not u.still and u.confirmed_at >= t.last_update
                    for u in self._born_beside(t, self._tracks, stamp))
 
     def _delete(self, stamp: float) -> None:

@@ -102,8 +102,7 @@ class TrackState:
         self.origin = np.array([x, y])
         self.recent_position = np.array([x, y])  # its position averaged over the last still_after_s, m
         self.existence = existence
-        self.confirmed = False
-        self.confirmed_at: float | None = None  # when it was confirmed (by its evidence), s
+        self.confirmed_at: float | None = None  # when it was confirmed, s (None: tentative)
         self.born_standing = standing
         self.moved = not standing  # has a moving candidate ever updated it
         self.update_kind: str | None = "static" if standing else "moving"  # how this scan updated it
@@ -190,6 +189,17 @@ class TrackState:
                      np.hypot(*(self.position - self.origin)) >= self.params.confirm_min_travel_m or
                      self.existence.shape_p >= self.params.confirm_leg_probability)):
             self.confirmed = True
+
+    @property
+    def confirmed(self) -> bool:
+        """Confirmed as a person (reported while likely enough); setting it records when."""
+        return self.confirmed_at is not None
+
+    @confirmed.setter
+    def confirmed(self, value: bool) -> None:
+        if not value:
+            self.confirmed_at = None
+        elif self.confirmed_at is None:
             self.confirmed_at = self.stamp
 
     @property
