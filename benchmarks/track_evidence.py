@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from people_tracker.models.pose import pairwise_distances
+from people_tracker.tracker.association import associate
 from people_tracker.tracker.config import load_config
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.bench import scene_ground_truth
@@ -97,15 +98,10 @@ def ids_per_person(run: SceneRun) -> dict[int, set[int]]:
     paired one to one (the pairing of least total distance, pairs within ``NEAR_M`` only), so
     a track is one person's at a time, as in CLEAR MOT's matching; someone else's track
     passing close by is not an id of theirs."""
-    from scipy.optimize import linear_sum_assignment
-
     ids: dict[int, set[int]] = {}
     for sel, tr in _scans_with_people(run):
-        d = pairwise_distances(tr.torso_world, run.world_rows[sel])
-        rows, cols = linear_sum_assignment(np.where(d <= NEAR_M, d, 1e6))
-        for i, j in zip(rows, cols):
-            if d[i, j] <= NEAR_M:
-                ids.setdefault(int(tr.person_id[i]), set()).add(int(run.rows[sel[j], 1]))
+        for i, j in associate(pairwise_distances(tr.torso_world, run.world_rows[sel]), NEAR_M, "gnn"):
+            ids.setdefault(int(tr.person_id[i]), set()).add(int(run.rows[sel[j], 1]))
     return ids
 
 

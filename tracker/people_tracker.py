@@ -355,7 +355,7 @@ class PeopleTracker:
         # legs near a tracked walking person are that person's: never paired with another
         # person's. A person standing still owns no moving legs: those are a passer-by's.
         people = np.array([t.position for t in self._tracks if t.confirmed and not t.still]).reshape(-1, 2)
-        groups = owners(xy, people, 0.5 * self.pairing.max_leg_separation_m)
+        groups = owners(xy, people, self._half_stride_m)
         return pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups,
                          np.array([o.width for o in objs]))
 
@@ -408,8 +408,9 @@ class PeopleTracker:
             z = np.array([(c.x, c.y) for c in candidates]).reshape(-1, 2)
             taken_c |= set(np.flatnonzero(pairwise_distances(z, walkers).min(axis=1) <= r).tolist())
         standing = [i for i, t in enumerate(ts) if t.confirmed and i not in taken_t and t.still]
-        step = 0.5 * self.pairing.max_leg_separation_m  # the stepping leg lands within half a stride of them
-        return pairs + self._recover_to(candidates, standing, [ts[i].position for i in standing], taken_c, step)
+        # the stepping leg lands within half a stride of them
+        return pairs + self._recover_to(candidates, standing, [ts[i].position for i in standing], taken_c,
+                                        self._half_stride_m)
 
     def _recover_to(self, candidates: list[PersonCandidate], idle: list[int], anchors: list[np.ndarray],
                     taken_c: set[int], radius_m: float) -> list[tuple[int, int]]:
@@ -551,6 +552,12 @@ class PeopleTracker:
                                                          self.assoc.start_leg_probability)
         self._spawn([c for ci, c in enumerate(candidates) if ci not in used and free[ci]], stamp)
 
+    @property
+    def _half_stride_m(self) -> float:
+        """Half of ``pairing.max_leg_separation_m``: farthest a leg lies from its person's
+        torso, and where a stepping leg lands from where they stood, m."""
+        return 0.5 * self.pairing.max_leg_separation_m
+
     def _duplicates(self) -> set[int]:
         """Indices of tracks that slid onto a person standing still who has a track already.
 
@@ -577,7 +584,7 @@ class PeopleTracker:
                 continue
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
-                passing = (np.hypot(*(walker.origin - stander.position)) > 0.5 * self.pairing.max_leg_separation_m
+                passing = (np.hypot(*(walker.origin - stander.position)) > self._half_stride_m
                            and walker.stamp - walker.last_moving_update <= self.track_params.still_after_s
                            and np.hypot(*walker.velocity) >= PASSING_MPS)
                 if not passing:  # born at their leg (their own leg's track), or sliding onto them

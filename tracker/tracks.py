@@ -93,7 +93,6 @@ class TrackState:
         self.kf = kf
         self.stamp = stamp  # time of the state, s
         self.born = stamp
-        self.last_weighed = stamp
         self.last_update = stamp
         self.last_moving_update = stamp
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
@@ -178,9 +177,9 @@ class TrackState:
 
     def weigh(self, visibility: int, leg_probability: float | None) -> None:
         """Book this scan's evidence of existence; confirm when it is strong enough."""
-        a = 1.0 - math.exp(-(self.stamp - self.last_weighed) / max(self.params.still_after_s, 1e-6))
+        # the existence's stamp is the last scan weighed
+        a = 1.0 - math.exp(-(self.stamp - self.existence.stamp) / max(self.params.still_after_s, 1e-6))
         self.recent_position += a * (self.position - self.recent_position)
-        self.last_weighed = self.stamp
         self.existence.update(self.stamp, self.update_kind, visibility, leg_probability,
                               self.still and self.place == "occupied", walking=self.moved and not self.still,
                               stale=self.stale)
