@@ -5,11 +5,13 @@ odometry's relative motion when the recording has odometry, and otherwise a
 constant-velocity prediction from the last matched motion. The scan is de-skewed first
 (the odometry's motion over the sweep, or the predicted one). Readings near people the
 tracker follows are left out of matching (they move). When matching fails the prior is
-kept, and the result says so.
+kept, and the result says so; without odometry the prediction then fades to rest
+(``AlignParams.fade_s``).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,11 +32,19 @@ class AlignParams:
     exclude_radius_m : float
         Readings this close to a tracked person are left out of matching.
     icp : IcpParams
+    fade_s : float
+        Without odometry, while matching fails (nothing in range to match), the predicted
+        motion fades to rest with this time constant, seconds. The sensor's motion is not
+        observed then: kept at the last matched speed, a robot that stops (behind its
+        person, say) would have the world frame run on without end, and everything it sees,
+        a person standing in front of it included, walk away in that frame; fading bounds
+        that error to the speed times ``fade_s``. 0: the last matched motion goes on unchanged.
     """
 
     enabled: bool = True
     exclude_radius_m: float = 0.5
     icp: IcpParams = IcpParams()
+    fade_s: float = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -153,6 +163,9 @@ class ScanAligner:
             self._world = odom
         if dt is not None and dt > 0 and (result is None or result.ok or kind == "odometry"):
             self._velocity = (rel, dt)
+        elif dt is not None and dt > 0 and self._velocity is not None and p.fade_s > 0:
+            motion, span = self._velocity  # not observed: fading to rest
+            self._velocity = (_scale_motion(motion, math.exp(-dt / p.fade_s)), span)
         tree = PointTree(points)
         self._ref = ReferenceScan(points, p.icp, tree) if p.enabled else None
         self._prev_stamp, self._prev_odom = scan.stamp, odom

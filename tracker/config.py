@@ -232,12 +232,14 @@ class AlignmentConfig:
     max_correction_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=100.0))
     max_correction_rad: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=3.15))
     max_source_points: int = field(metadata=_spec(lo=0, hi=1000000))
+    fade_s: float = field(metadata=_spec(lo=0.0, hi=3600.0))
 
     def params(self):
         from people_tracker.detection.align import AlignParams
         from people_tracker.detection.icp import IcpParams
-        icp = {k: v for k, v in dataclasses.asdict(self).items() if k not in ("enabled", "exclude_radius_m")}
-        return AlignParams(self.enabled, self.exclude_radius_m, IcpParams(**icp))
+        own = ("enabled", "exclude_radius_m", "fade_s")
+        icp = {k: v for k, v in dataclasses.asdict(self).items() if k not in own}
+        return AlignParams(self.enabled, self.exclude_radius_m, IcpParams(**icp), self.fade_s)
 
 
 @dataclass(frozen=True)

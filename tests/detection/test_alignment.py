@@ -2,6 +2,7 @@
 
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -83,3 +84,32 @@ def test_bare_corridor_is_found_degenerate_and_keeps_the_prior_along_it():
     without = simulated_errors(plain_corridor(), use_odometry=False, duration=8)
     assert without["degenerate"] > 0.9
     assert without["r95"] < 0.1  # heading and the lateral position are still matched
+
+
+def _blind(scan, stamp):
+    """The scan a laser with nothing in range gives at ``stamp``."""
+    return replace(scan, ranges=np.full(scan.n_beams, np.inf), stamp=stamp)
+
+
+@pytest.mark.parametrize("fade_s", [0.0, 0.5])
+def test_without_anything_to_match_the_predicted_motion_fades_to_rest(fade_s):
+    """Without odometry and with nothing in range, the sensor's motion is not observed: the
+    last matched motion goes on (fade_s 0) or fades to rest with the time constant fade_s."""
+    from people_tracker.detection.align import AlignParams, ScanAligner
+
+    world = build_world({"room": [-4, -3, 6, 5], "boxes": [[1, 2, 2, 3]], "pillars": [[3, -1, 0.3]]})
+    laser = LaserModel()
+    aligner = ScanAligner(AlignParams(fade_s=fade_s))
+    dt, speed = 0.1, 1.0  # s, m/s
+    for k in range(4):  # matched: 1 m/s along x
+        scan, _ = laser.render(k * dt, Pose2D(speed * k * dt, 0.0, 0.0), world.segments, world.circles, None)
+        scan = replace(scan, time_increment=0.0)  # rendered from one pose: no skew
+        pose = aligner.align(scan).pose
+    assert pose.x == pytest.approx(3 * dt * speed, abs=0.01)
+    steps = []
+    for k in range(4, 10):  # nothing in range
+        before = pose
+        pose = aligner.align(_blind(scan, k * dt)).pose
+        steps.append(before.between(pose).x)
+    expected = speed * dt * np.exp(-dt / fade_s * np.arange(6)) if fade_s else np.full(6, speed * dt)
+    assert steps == pytest.approx(expected, abs=0.01 * speed * dt)
