@@ -455,7 +455,7 @@ def test_someone_who_sets_off_hands_their_id_to_their_walking_track_after_the_tr
     walker.track_id = 2
     walker.born = 0.0  # began at 0 s beside them
     stander.last_update = 0.13  # the trailing leg, one scan later
-    walker.confirmed, walker.confirmed_at = True, 0.8  # walked off
+    walker.confirmed_at = 0.8  # confirmed (walked off) at 0.8 s
     for t in (stander, walker):
         t.stamp = 0.93
         t.update_kind = None
