@@ -415,12 +415,20 @@ class PeopleTracker:
     def _recover_to(self, candidates: list[PersonCandidate], idle: list[int], anchors: list[np.ndarray],
                     taken_c: set[int], radius_m: float) -> list[tuple[int, int]]:
         """Give the free candidates within ``radius_m`` of each idle track's anchor (world
-        frame, m) to the nearest, one each; those tracks forget their velocity."""
+        frame, m) to the nearest, one each; those tracks forget their velocity. A candidate
+        lying nearer another track (where it is now) than the idle track's anchor is that
+        other track's: a passer-by's second leg, not the lost person turning."""
         free = [k for k in range(len(candidates)) if k not in taken_c]
         if not idle or not free:
             return []
         z = np.array([(candidates[k].x, candidates[k].y) for k in free])
-        pairs = associate(pairwise_distances(np.array(anchors), z), radius_m, "gnn")
+        cost = pairwise_distances(np.array(anchors), z)
+        here = pairwise_distances(np.array([t.position for t in self._tracks]), z)  # every track to every candidate
+        for a, i in enumerate(idle):
+            others = np.delete(here, i, axis=0)
+            if len(others):
+                cost[a, others.min(axis=0) < cost[a]] = np.inf
+        pairs = associate(cost, radius_m, "gnn")
         for a, _ in pairs:
             self._tracks[idle[a]].forget_velocity()
         return [(idle[a], free[b]) for a, b in pairs]

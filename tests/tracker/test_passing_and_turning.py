@@ -173,3 +173,27 @@ def test_someone_still_seen_standing_keeps_their_track_beside_a_newcomer():
     stander.update(np.array([3.0, 0.0]), np.eye(2) * 0.05 ** 2, moving=False)  # still there this scan
     tracker._delete(5.1)
     assert sorted(t.track_id for t in tracker._tracks) == [1, 2]
+
+
+def _lost_walker(other_at=None):
+    """A tracker with a confirmed walker last seen moving at (2, 0) 0.3 s ago (world frame,
+    m) and, optionally, another confirmed track at ``other_at``."""
+    tracker = PeopleTracker.from_config(load_config())
+    tracker._spawn([PersonCandidate(2.0, 0.0, 0.05, "pair")], 0.0)
+    if other_at is not None:
+        tracker._spawn([PersonCandidate(*other_at, 0.05, "pair")], 0.0)
+    for t in tracker._tracks:
+        t.confirmed = True
+        t.predict(0.3)
+    return tracker
+
+
+def test_a_lost_walker_does_not_take_a_leftover_that_lies_nearer_someone_else():
+    # the walker's legs were hidden this scan; a leftover 0.7 m from where they were last
+    # seen moving, within the recover radius (a sharp turn would look like this) ...
+    leftover = PersonCandidate(1.3, 0.1, 0.08, "pair")
+    assert _lost_walker()._recover([leftover], []) == [(0, 0)]
+    # ... but 0.3 m from a passer-by's track, which took its other leg this scan: the
+    # passer-by's, not the walker turning
+    passer_leg = PersonCandidate(1.1, -0.25, 0.08, "leg")
+    assert _lost_walker(other_at=(1.1, -0.15))._recover([leftover, passer_leg], [(1, 1)]) == []
