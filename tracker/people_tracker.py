@@ -378,13 +378,14 @@ class PeopleTracker:
             far = np.where(moved[:, None], d_here > self.track_params.min_person_separation_m,
                            d_found > self.assoc.recover_radius_m)
             cost[still[:, None] & far] = np.inf
-        # confirmed tracks choose first: a tentative track never takes a confirmed one's candidate
-        confirmed = np.array([t.confirmed for t in self._tracks])
-        pairs = associate(np.where(confirmed[:, None], cost, np.inf), self.assoc.gate_chi2, self.assoc.method)
-        taken_c = {c for _, c in pairs}
-        rest = np.where(~confirmed[:, None], cost, np.inf)
-        rest[:, list(taken_c)] = np.inf
-        return pairs + associate(rest, self.assoc.gate_chi2, self.assoc.method)
+        # one assignment for every track; a tentative track pays -2 ln P(it exists) on top of
+        # the squared Mahalanobis distance (a pairing's negative log-likelihood), so a new
+        # track on someone's second leg gives way to their confirmed track, while a passer-by's
+        # new track keeps a candidate that is clearly theirs when a confirmed track lost its own
+        doubt = np.array([0.0 if t.confirmed else -2.0 * math.log(max(t.existence.probability, 1e-9))
+                          for t in self._tracks])
+        cost = np.where(cost <= self.assoc.gate_chi2, cost + doubt[:, None], np.inf)
+        return associate(cost, float(np.max(doubt, initial=0.0)) + self.assoc.gate_chi2, self.assoc.method)
 
     def _recover(self, candidates: list[PersonCandidate], matched: list[tuple[int, int]]) -> list[tuple[int, int]]:
         """Leftover candidates for confirmed tracks the gate left alone: first tracks that lost

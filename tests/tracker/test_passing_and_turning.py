@@ -197,3 +197,30 @@ def test_a_lost_walker_does_not_take_a_leftover_that_lies_nearer_someone_else():
     # passer-by's, not the walker turning
     passer_leg = PersonCandidate(1.1, -0.25, 0.08, "leg")
     assert _lost_walker(other_at=(1.1, -0.15))._recover([leftover, passer_leg], [(1, 1)]) == []
+
+
+def _confirmed_and_new(new_at):
+    """A confirmed track at (2, 0) and a tentative one just born at ``new_at`` (world frame,
+    m), both predicted 0.3 s on."""
+    tracker = PeopleTracker.from_config(load_config())
+    tracker._spawn([PersonCandidate(2.0, 0.0, 0.05, "pair")], 0.0)
+    tracker._spawn([PersonCandidate(*new_at, 0.05, "leg")], 0.2)
+    tracker._tracks[0].confirmed = True
+    for t in tracker._tracks:
+        t.predict(0.3)
+    return tracker
+
+
+def test_a_passer_by_new_track_keeps_the_candidate_that_is_clearly_theirs():
+    # the confirmed person's legs are hidden; the passer-by's candidate lies on their new
+    # track and within the person's gate: it stays the passer-by's
+    tracker = _confirmed_and_new((2.6, 0.3))
+    assert tracker._associate([PersonCandidate(2.6, 0.3, 0.08, "pair")]) == [(1, 0)]
+
+
+def test_a_new_track_gives_way_to_a_confirmed_one_when_in_doubt():
+    # a candidate nearer the new track (0.15 m) than the confirmed one (0.5 m), but not by
+    # enough to outweigh the new track's doubt (squared distances about 1.2 and 2.4, the
+    # doubt -2 ln 0.2 = 3.2): the confirmed person's
+    tracker = _confirmed_and_new((2.65, 0.0))
+    assert tracker._associate([PersonCandidate(2.5, 0.0, 0.08, "leg")]) == [(0, 0)]
