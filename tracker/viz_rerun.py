@@ -125,16 +125,23 @@ class RerunSink(Sink):
         self.rec = rr.RecordingStream(name)
         self._target = Path(rrd) if rrd else None
         self._tmp = None
-        if self._target is not None:
-            fd, tmp = temp_beside(self._target)
-            os.close(fd)
-            self._tmp = Path(tmp)
-            self.rec.save(str(self._tmp))
-        elif spawn:
-            self._spawn()
         self._trails: dict[int, deque] = defaultdict(lambda: deque(maxlen=_TRAIL))
         self._history: dict[int, list[tuple[float, float]]] = defaultdict(list)  # whole trajectories
         self._path: list[tuple[float, float]] = []
+        try:  # interrupted while starting (Ctrl-C as rerun loads): the hidden file goes too
+            self._start(spawn)
+        except BaseException:
+            self.abort()
+            raise
+
+    def _start(self, spawn: bool) -> None:
+        if self._target is not None:
+            fd, tmp = temp_beside(self._target)
+            self._tmp = Path(tmp)
+            os.close(fd)
+            self.rec.save(str(self._tmp))
+        elif spawn:
+            self._spawn()
         self.rec.send_blueprint(rrb.Blueprint(
             rrb.Horizontal(
                 rrb.Spatial2DView(origin="world", name="world (m)"),

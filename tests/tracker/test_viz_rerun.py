@@ -57,3 +57,19 @@ def test_failed_run_leaves_no_rrd(tmp_path):
     (tmp_path / "bad.bag").write_bytes(b"garbage" * 100)
     proc = run_cli("run", str(tmp_path / "bad.bag"), "--rrd", str(tmp_path / "x.rrd"))
     assert proc.returncode == 2 and list(tmp_path.iterdir()) == [tmp_path / "bad.bag"]
+
+
+def test_ctrl_c_while_the_recording_starts_leaves_no_hidden_file(tmp_path, monkeypatch):
+    # on a loaded machine Ctrl-C can come while rerun is still starting, after the hidden
+    # .part file beside the target was made
+    import rerun as rr
+
+    from people_tracker.tracker.viz_rerun import RerunSink
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(rr.RecordingStream, "send_blueprint", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        RerunSink(tmp_path / "r.rrd")
+    assert list(tmp_path.iterdir()) == []
