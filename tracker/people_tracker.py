@@ -426,9 +426,8 @@ class PeopleTracker:
         cost = pairwise_distances(np.array(anchors), z)
         here = pairwise_distances(np.array([t.position for t in self._tracks]), z)  # every track to every candidate
         for a, i in enumerate(idle):
-            others = np.delete(here, i, axis=0)
-            if len(others):
-                cost[a, others.min(axis=0) < cost[a]] = np.inf
+            nearest_other = np.delete(here, i, axis=0).min(axis=0, initial=np.inf)
+            cost[a, nearest_other < cost[a]] = np.inf
         pairs = associate(cost, radius_m, "gnn")
         for a, _ in pairs:
             self._tracks[idle[a]].forget_velocity()

@@ -175,15 +175,16 @@ def test_someone_still_seen_standing_keeps_their_track_beside_a_newcomer():
     assert sorted(t.track_id for t in tracker._tracks) == [1, 2]
 
 
-def _lost_walker(other_at=None):
-    """A tracker with a confirmed walker last seen moving at (2, 0) 0.3 s ago (world frame,
-    m) and, optionally, another confirmed track at ``other_at``."""
+def _two_tracks(other_at=None, other_born_s=0.0, other_confirmed=True):
+    """A tracker with a confirmed track born at (2, 0) at 0 s (world frame, m) and, optionally,
+    another born at ``other_at`` at ``other_born_s``, confirmed or tentative; both predicted
+    to 0.3 s, neither updated since it was born."""
     tracker = PeopleTracker.from_config(load_config())
     tracker._spawn([PersonCandidate(2.0, 0.0, 0.05, "pair")], 0.0)
     if other_at is not None:
-        tracker._spawn([PersonCandidate(*other_at, 0.05, "pair")], 0.0)
+        tracker._spawn([PersonCandidate(*other_at, 0.05, "pair")], other_born_s)
     for t in tracker._tracks:
-        t.confirmed = True
+        t.confirmed = t is tracker._tracks[0] or other_confirmed
         t.predict(0.3)
     return tracker
 
@@ -192,29 +193,17 @@ def test_a_lost_walker_does_not_take_a_leftover_that_lies_nearer_someone_else():
     # the walker's legs were hidden this scan; a leftover 0.7 m from where they were last
     # seen moving, within the recover radius (a sharp turn would look like this) ...
     leftover = PersonCandidate(1.3, 0.1, 0.08, "pair")
-    assert _lost_walker()._recover([leftover], []) == [(0, 0)]
+    assert _two_tracks()._recover([leftover], []) == [(0, 0)]
     # ... but 0.3 m from a passer-by's track, which took its other leg this scan: the
     # passer-by's, not the walker turning
     passer_leg = PersonCandidate(1.1, -0.25, 0.08, "leg")
-    assert _lost_walker(other_at=(1.1, -0.15))._recover([leftover, passer_leg], [(1, 1)]) == []
-
-
-def _confirmed_and_new(new_at):
-    """A confirmed track at (2, 0) and a tentative one just born at ``new_at`` (world frame,
-    m), both predicted 0.3 s on."""
-    tracker = PeopleTracker.from_config(load_config())
-    tracker._spawn([PersonCandidate(2.0, 0.0, 0.05, "pair")], 0.0)
-    tracker._spawn([PersonCandidate(*new_at, 0.05, "leg")], 0.2)
-    tracker._tracks[0].confirmed = True
-    for t in tracker._tracks:
-        t.predict(0.3)
-    return tracker
+    assert _two_tracks(other_at=(1.1, -0.15))._recover([leftover, passer_leg], [(1, 1)]) == []
 
 
 def test_a_passer_by_new_track_keeps_the_candidate_that_is_clearly_theirs():
     # the confirmed person's legs are hidden; the passer-by's candidate lies on their new
     # track and within the person's gate: it stays the passer-by's
-    tracker = _confirmed_and_new((2.6, 0.3))
+    tracker = _two_tracks((2.6, 0.3), other_born_s=0.2, other_confirmed=False)
     assert tracker._associate([PersonCandidate(2.6, 0.3, 0.08, "pair")]) == [(1, 0)]
 
 
@@ -222,5 +211,5 @@ def test_a_new_track_gives_way_to_a_confirmed_one_when_in_doubt():
     # a candidate nearer the new track (0.15 m) than the confirmed one (0.5 m), but not by
     # enough to outweigh the new track's doubt (squared distances about 1.2 and 2.4, the
     # doubt -2 ln 0.2 = 3.2): the confirmed person's
-    tracker = _confirmed_and_new((2.65, 0.0))
+    tracker = _two_tracks((2.65, 0.0), other_born_s=0.2, other_confirmed=False)
     assert tracker._associate([PersonCandidate(2.5, 0.0, 0.08, "leg")]) == [(0, 0)]
