@@ -368,6 +368,8 @@ def replay(path: str, topic: str | None, rate: float, config, wait_s: float = 5.
         deadline = time.monotonic() + wait_s
         while pub_scan.get_subscription_count() == 0 and time.monotonic() < deadline:
             time.sleep(0.05)
+        if pub_scan.get_subscription_count():
+            time.sleep(0.5)  # the subscriber's side of the match settles too: best-effort scans sent before are lost
         reader = rec._reader
         scan_ids = {c.id for c in rec._scan_conns}
         start_wall = first_bag = None

@@ -119,6 +119,7 @@ BAD = textwrap.dedent('''
     odom = n.create_publisher(Odometry, "/odom", QoSProfile(depth=100))
     while scans.get_subscription_count() == 0:
         time.sleep(0.05)
+    time.sleep(1.0)  # the node's side of the match settles too: best-effort scans sent before are lost
     def scan(k, ranges):
         m = LaserScan()
         m.header.stamp.sec, m.header.stamp.nanosec = 100 + k // 10, (k % 10) * 100000000
