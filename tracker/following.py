@@ -43,9 +43,13 @@ class TargetSelector:
         track was last updated, up to ``max_reach_m``. With an id given, the one other track
         there takes the id of a lost person.
     relock_s : float
-        ``auto``: when the person has been lost this long (s), the one reported track in the
-        lock zone ahead (none when there are several) takes their id, and their place is
-        learnt afresh from it.
+        ``auto``: when the person has been lost this long (s), the one person in the lock
+        zone ahead (none when there are several) takes their id, and their place is learnt
+        afresh from them.
+    same_person_m : float
+        Reported tracks in the zone ahead all within this distance (m) of the closest of
+        them are one person seen twice (a track on each leg), not several people: the
+        closest takes the id.
     coast_s : float
         A target track not updated for this long (s), while exactly one other track was
         updated where the person should be, gives the id to that one.
@@ -59,13 +63,13 @@ class TargetSelector:
     def __init__(self, mode: str | int | None, reacquire_s: float = 10.0, reacquire_m: float = 0.8,
                  ahead_deg: float = 60.0, lock_range_m: float = 3.5, walk_mps: float = 1.5,
                  coast_s: float = 0.5, max_reach_m: float = 4.0, steady_s: float = 1.5,
-                 slide_m: float = 0.6, relock_s: float = 1.0) -> None:
+                 slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
         self._ahead_rad, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
         self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
-        self.relock_s = relock_s
+        self.relock_s, self._same_person_m = relock_s, same_person_m
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
         self._v = np.zeros(2)  # ... its rate of change (m/s) ...
@@ -163,9 +167,13 @@ class TargetSelector:
 
     def _ahead(self, tracks: dict[int, np.ndarray], only: bool = False) -> int | None:
         """The closest track (id → sensor-frame place, m) in the follow zone ahead (with
-        ``only``, the one track there), or None."""
+        ``only``, when the tracks there are one person's), or None."""
         ahead = self.in_front(tracks)
-        return None if not ahead or (only and len(ahead) > 1) else ahead[0]
+        if not ahead:
+            return None
+        if only and any(math.dist(tracks[tid], tracks[ahead[0]]) > self._same_person_m for tid in ahead[1:]):
+            return None
+        return ahead[0]
 
     def choose(self, reported: dict[int, np.ndarray]) -> int | None:
         """The target id now, given reported tracks (id → sensor-frame place, m)."""

@@ -115,7 +115,9 @@ class PeopleTracker:
         self.pairing = pairing or PairingParams()
         self.track_params = tracks or TrackParams()
         self.assoc = association or AssociationParams()
-        self.selector = TargetSelector(follow) if follow is not None else None
+        # tracks ahead closer together than two people's torsos can be are one person seen twice
+        self.selector = (TargetSelector(follow, same_person_m=self.track_params.min_person_separation_m)
+                         if follow is not None else None)
         self.standing = StandingInitiator(standing or StandingParams())
         self.leg_model = leg_model if leg_model is not None else load_leg_model()
         self.existence = existence or ExistenceParams()

@@ -115,6 +115,19 @@ def test_a_lost_person_is_not_guessed_among_several_in_front():
     assert TargetSelector(5).reacquire(1.3, {7: np.array([2.2, 0.1])}) is None  # an id given by the user: never
 
 
+def test_two_tracks_in_front_closer_than_two_people_can_stand_are_one_person():
+    sel = TargetSelector("auto", same_person_m=0.35)
+    sel.target = 1
+    sel.seen(0.0, np.array([2.0, 2.0]))
+    sel.yaw = math.pi
+    sel.lost(0.2)
+    legs = {7: np.array([2.3, 0.1]), 9: np.array([2.1, -0.1])}  # a track on each of one person's legs, 0.28 m apart
+    assert sel.reacquire(1.3, legs) == 9  # the closer of the two takes the id
+    sel.lost(1.5)
+    two_people = {7: np.array([2.3, 0.3]), 9: np.array([2.1, -0.1])}  # 0.45 m apart: two people, may be either
+    assert sel.reacquire(2.6, two_people) is None
+
+
 def test_someone_who_stood_still_and_sets_off_briskly_keeps_their_id():
     # walks in, stands 8 s, sets off at 1.3 m/s: the first step lands beyond the standing track's gate
     spec = {"duration_s": 16.0, "laser": LASER, "world": {"room": [-1, -6, 9, 6]},
