@@ -503,10 +503,20 @@ class PeopleTracker:
         anchors = np.array([self._tracks[i].moving_position for i in idle])
         far = pairwise_distances(anchors, z) > self.assoc.support_anchor_m
         cost[far] = np.inf
-        out = set()
+        out, used = set(), set()
         for a, b in associate(cost, self.assoc.gate_chi2, self.assoc.method):
             self._tracks[idle[a]].update(z[b], standing[b].R, moving=False)
             out.add(idle[a])
+            used.add(b)
+        # a walker lost within the last second (a sharp turn the prediction missed) takes a
+        # leftover pair within reach of where they last moved, as they would a moving candidate
+        ts = self._tracks
+        lost = [i for i in idle if i not in out and ts[i].confirmed and not ts[i].still
+                and ts[i].stamp - ts[i].last_moving_update <= 1.0]
+        for i, b in self._recover_to(standing, lost, [ts[i].moving_position for i in lost], used,
+                                     self.assoc.recover_radius_m):
+            ts[i].update(z[b], standing[b].R, moving=False)
+            out.add(i)
         return out
 
     def _initiate_standing(self, standing: list[PersonCandidate], stamp: float) -> None:
