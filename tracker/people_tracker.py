@@ -93,7 +93,6 @@ class StepResult:
 
 PASSING_MPS = 0.5  # m/s: a track this fast passing close by someone standing is a passer-by, not them twice
 SET_OFF_S = 3.0  # s: a track this young that began beside someone standing may be them, set off
-TURN_S = 1.0  # s: a walker whose legs were last seen moving this recently may have turned sharply
 
 
 class PeopleTracker:
@@ -403,7 +402,8 @@ class PeopleTracker:
             return []
         taken_t, taken_c = {t for t, _ in matched}, {c for _, c in matched}
         ts = self._tracks
-        lost = self._lost_walkers(i for i in range(len(ts)) if i not in taken_t)
+        lost = [i for i, t in enumerate(ts)
+                if t.confirmed and i not in taken_t and not t.still and t.stamp - t.last_moving_update <= 1.0]
         pairs = self._recover_to(candidates, lost, [ts[i].moving_position for i in lost], taken_c, r)
         taken_c |= {c for _, c in pairs}
         walkers = np.array([t.position for t in ts if t.confirmed and not t.still]).reshape(-1, 2)
@@ -414,13 +414,6 @@ class PeopleTracker:
         # the stepping leg lands within half a stride of them
         return pairs + self._recover_to(candidates, standing, [ts[i].position for i in standing], taken_c,
                                         self._half_stride_m)
-
-    def _lost_walkers(self, indices) -> list[int]:
-        """Of the tracks at ``indices``, the confirmed walkers whose legs were last seen
-        moving within ``TURN_S``: perhaps turned sharply where the prediction walks on."""
-        ts = self._tracks
-        return [i for i in indices
-                if ts[i].confirmed and not ts[i].still and ts[i].stamp - ts[i].last_moving_update <= TURN_S]
 
     def _recover_to(self, candidates: list[PersonCandidate], idle: list[int], anchors: list[np.ndarray],
                     taken_c: set[int], radius_m: float) -> list[tuple[int, int]]:
@@ -510,19 +503,10 @@ class PeopleTracker:
         anchors = np.array([self._tracks[i].moving_position for i in idle])
         far = pairwise_distances(anchors, z) > self.assoc.support_anchor_m
         cost[far] = np.inf
-        out, used = set(), set()
+        out = set()
         for a, b in associate(cost, self.assoc.gate_chi2, self.assoc.method):
             self._tracks[idle[a]].update(z[b], standing[b].R, moving=False)
             out.add(idle[a])
-            used.add(b)
-        # a walker lost within the last second (a sharp turn the prediction missed) takes a
-        # leftover pair within reach of where they last moved, as they would a moving candidate
-        ts = self._tracks
-        lost = self._lost_walkers(i for i in idle if i not in out)
-        for i, b in self._recover_to(standing, lost, [ts[i].moving_position for i in lost], used,
-                                     self.assoc.recover_radius_m):
-            ts[i].update(z[b], standing[b].R, moving=False)
-            out.add(i)
         return out
 
     def _initiate_standing(self, standing: list[PersonCandidate], stamp: float) -> None:

@@ -213,18 +213,6 @@ def test_a_lost_walker_does_not_take_a_leftover_that_lies_nearer_someone_else():
     assert _two_tracks(other_at=(1.1, -0.15))._recover([leftover, passer_leg], [(1, 1)]) == []
 
 
-def test_a_lost_walker_takes_a_leg_pair_within_reach_of_where_they_last_moved():
-    # no moving candidate this scan (a sharp turn, the person's legs not seen moving), but a
-    # pair of leg-shaped readings 0.7 m from where they last moved: beyond what static
-    # evidence may update a walker with, within what a moving candidate could
-    pair = PersonCandidate(1.3, 0.1, 0.08, "standing")
-    tracker = _two_tracks()
-    assert tracker._update_standing([pair]) == {0}
-    assert np.hypot(*(tracker._tracks[0].position - [1.3, 0.1])) < 0.1
-    # ... not when it lies nearer someone else's track: theirs
-    assert _two_tracks(other_at=(1.2, 0.35))._update_standing([pair]) == {1}
-
-
 def test_a_passer_by_new_track_keeps_the_candidate_that_is_clearly_theirs():
     # the confirmed person's legs are hidden; the passer-by's candidate lies on their new
     # track and within the person's gate: it stays the passer-by's
