@@ -93,6 +93,7 @@ class StepResult:
 
 PASSING_MPS = 0.5  # m/s: a track this fast passing close by someone standing is a passer-by, not them twice
 SET_OFF_S = 3.0  # s: a track this young that began beside someone standing may be them, set off
+TURN_S = 1.0  # s: a walker whose legs were last seen moving this recently may have turned sharply
 
 
 class PeopleTracker:
@@ -122,7 +123,8 @@ class PeopleTracker:
         self.leg_model = leg_model if leg_model is not None else load_leg_model()
         self.existence = existence or ExistenceParams()
         self.places = PlaceMemory(self.existence.place_keyframe_s, self.existence.place_memory_s)
-        # where people who walked in stand still: [xy (m), last stamp (s), id, l_dyn, only a guess (bool)]
+        # where people who walked in stand still: [xy (world, m), last stamp (s), id, l_dyn,
+        # only a guess (bool), when they came (s: their track last moved)]
         self._stood: list[list] = []
         self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
         self._leg_scores = np.zeros(0)  # ... and their leg probabilities
@@ -272,7 +274,7 @@ class PeopleTracker:
                                   self.detector.params.no_return_free_m) == OCCLUDED
         for t, xy, h in zip(walkers, middle, hidden):
             if h:
-                self._stood.append([xy, scan.stamp, t.track_id, t.existence.l_dyn, True])
+                self._stood.append([xy, scan.stamp, t.track_id, t.existence.l_dyn, True, t.last_moving_update])
             t.hidden_position = None  # once per spell out of sight
 
     def _remember_standing(self, scan: Scan, world: Pose2D) -> None:
@@ -288,17 +290,21 @@ class PeopleTracker:
             if t.reported and t.moved and t.still and t.place != PlaceMemory.OCCUPIED_ONLY:
                 for e in stood:
                     if e[2] == t.track_id or np.hypot(*(e[0] - t.position)) <= self.assoc.support_anchor_m:
-                        e[:] = [t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False]
+                        # a track taken up here again began standing: they came when first remembered
+                        e[:] = [t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False,
+                                min(e[5], t.last_moving_update)]
                         break
                 else:
-                    stood.append([t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False])
+                    stood.append([t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False, t.last_moving_update])
         self._stood = stood[-1000:]
 
     def _reacquire_standing(self, scan: Scan, world: Pose2D) -> None:
         """A person-sized object where someone stood, and no track there: that person, seen
         again after their track was lost (someone walked between, the track went with the
         passer-by). They get their id back when it is free, and their evidence. Where they
-        were only guessed to stand (:meth:`_remember_hidden_stops`), the object must look like a leg."""
+        were only guessed to stand (:meth:`_remember_hidden_stops`), the object must look like
+        a leg; what the laser saw there before they came, and never saw empty, is furniture,
+        and the place is forgotten."""
         if not self._stood:
             return
         clear = self._clear_of_tracks(np.array([e[0] for e in self._stood]))
@@ -308,6 +314,7 @@ class PeopleTracker:
         found = self._static_support(np.array([e[0] for e in lost]), scan, world)
         used = {t.track_id for t in self._tracks}
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
+        furniture = []
         for e, z in zip(lost, found):
             if z is None or np.hypot(*(z - e[0])) > self.assoc.support_anchor_m:
                 continue
@@ -315,6 +322,11 @@ class PeopleTracker:
             # look at least as leg-like as the leg model's base rate (as for any track back in
             # view): clutter the view clears on is not them
             if e[4] and not np.nan_to_num(self._best_leg(z[None]))[0] >= self.leg_model.base_rate:
+                continue
+            # what the laser saw there, and never saw empty, before they came is furniture (a
+            # table leg beside where someone stood keeps the place occupied after they leave)
+            if self._place_history(z, e[5]) == PlaceMemory.OCCUPIED_ONLY:
+                furniture.append(e)
                 continue
             e[4] = False
             ex = Existence(self.existence, scan.stamp, True, True, None, self.leg_model.base_rate)
@@ -328,6 +340,8 @@ class PeopleTracker:
             self._tracks.append(t)
             used.add(track_id)
             e[2] = track_id
+        if furniture:
+            self._stood = [e for e in self._stood if not any(e is f for f in furniture)]
 
     def _place_history(self, xy: np.ndarray, since: float) -> str:
         e = self.existence
@@ -402,8 +416,7 @@ class PeopleTracker:
             return []
         taken_t, taken_c = {t for t, _ in matched}, {c for _, c in matched}
         ts = self._tracks
-        lost = [i for i, t in enumerate(ts)
-                if t.confirmed and i not in taken_t and not t.still and t.stamp - t.last_moving_update <= 1.0]
+        lost = self._lost_walkers(i for i in range(len(ts)) if i not in taken_t)
         pairs = self._recover_to(candidates, lost, [ts[i].moving_position for i in lost], taken_c, r)
         taken_c |= {c for _, c in pairs}
         walkers = np.array([t.position for t in ts if t.confirmed and not t.still]).reshape(-1, 2)
@@ -414,6 +427,13 @@ class PeopleTracker:
         # the stepping leg lands within half a stride of them
         return pairs + self._recover_to(candidates, standing, [ts[i].position for i in standing], taken_c,
                                         self._half_stride_m)
+
+    def _lost_walkers(self, indices) -> list[int]:
+        """Of the tracks at ``indices``, the confirmed walkers whose legs were last seen
+        moving within ``TURN_S``: perhaps turned sharply where the prediction walks on."""
+        ts = self._tracks
+        return [i for i in indices
+                if ts[i].confirmed and not ts[i].still and ts[i].stamp - ts[i].last_moving_update <= TURN_S]
 
     def _recover_to(self, candidates: list[PersonCandidate], idle: list[int], anchors: list[np.ndarray],
                     taken_c: set[int], radius_m: float) -> list[tuple[int, int]]:
@@ -503,10 +523,21 @@ class PeopleTracker:
         anchors = np.array([self._tracks[i].moving_position for i in idle])
         far = pairwise_distances(anchors, z) > self.assoc.support_anchor_m
         cost[far] = np.inf
-        out = set()
+        out, used = set(), set()
         for a, b in associate(cost, self.assoc.gate_chi2, self.assoc.method):
             self._tracks[idle[a]].update(z[b], standing[b].R, moving=False)
             out.add(idle[a])
+            used.add(b)
+        # a walker lost within the last second (a sharp turn the prediction missed) takes a
+        # leftover pair within reach of where they last moved, as they would a moving candidate,
+        # unless the laser saw that place occupied, and never empty, before: furniture
+        ts = self._tracks
+        lost = self._lost_walkers(i for i in idle if i not in out)
+        for i, b in self._recover_to(standing, lost, [ts[i].moving_position for i in lost], used,
+                                     self.assoc.recover_radius_m):
+            if self._place_history(z[b], ts[i].stamp) != PlaceMemory.OCCUPIED_ONLY:
+                ts[i].update(z[b], standing[b].R, moving=False)
+                out.add(i)
         return out
 
     def _initiate_standing(self, standing: list[PersonCandidate], stamp: float) -> None:

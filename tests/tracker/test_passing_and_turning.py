@@ -213,6 +213,54 @@ def test_a_lost_walker_does_not_take_a_leftover_that_lies_nearer_someone_else():
     assert _two_tracks(other_at=(1.1, -0.15))._recover([leftover, passer_leg], [(1, 1)]) == []
 
 
+def test_a_lost_walker_takes_a_leg_pair_within_reach_of_where_they_last_moved():
+    # no moving candidate this scan (a sharp turn, the person's legs not seen moving), but a
+    # pair of leg-shaped readings 0.7 m from where they last moved: beyond what static
+    # evidence may update a walker with, within what a moving candidate could
+    pair = PersonCandidate(1.3, 0.1, 0.08, "standing")
+    tracker = _two_tracks()
+    assert tracker._update_standing([pair]) == {0}
+    assert np.hypot(*(tracker._tracks[0].position - [1.3, 0.1])) < 0.1
+    # ... not when it lies nearer someone else's track: theirs
+    assert _two_tracks(other_at=(1.2, 0.35))._update_standing([pair]) == {1}
+
+
+def test_a_lost_walker_does_not_take_a_leg_pair_where_the_laser_only_ever_saw_something():
+    """Traced in the waiting room: a walker lost in a turn took a pair of table legs 0.7 m
+    away, there from the first scan. A place the laser saw occupied for minutes, and never
+    empty, before the walker came is furniture's: the walker's track does not take it."""
+    import dataclasses
+
+    pair = PersonCandidate(1.3, 0.1, 0.08, "standing")
+    tables = _scan([[1.3, 0.0, 0.03], [1.3, 0.2, 0.03]])  # two table legs 0.2 m apart
+    empty = _scan([])
+    for seen, taken in ((tables, set()), (empty, {0})):
+        tracker = _two_tracks()
+        for stamp in np.arange(-30.0, -2.0, 1.0):  # half a minute of keyframes before the walker came
+            tracker.places.add(dataclasses.replace(seen, stamp=float(stamp)), Pose2D())
+        assert tracker._update_standing([pair]) == taken
+
+
+def test_where_someone_stood_furniture_that_was_there_before_them_does_not_take_their_id():
+    """Traced in the waiting room (seed 33): a person stood beside a table leg and left; the
+    table leg kept their place occupied (never seen empty), so the memory of where they stood
+    stayed, and the table leg took their id and evidence back for the last three minutes.
+    What is found there must not be something the laser saw there, and never saw empty,
+    before they came."""
+    import dataclasses
+
+    scan = _scan([[3.0, 0.0, 0.03]])  # one thin thing where they stood (a table leg, or their legs together)
+    for before, taken in ((scan, False), (_scan([]), True)):
+        tracker = PeopleTracker.from_config(load_config())
+        for stamp in np.arange(-30.0, 0.0, 1.0):  # half a minute of keyframes before they came at 0 s
+            tracker.places.add(dataclasses.replace(before, stamp=float(stamp)), Pose2D())
+        # id 7 stood there from 0 s on (evidence 3, log-odds), last seen there at 60 s
+        tracker._stood = [[np.array([3.0, 0.0]), 60.0, 7, 3.0, False, 0.0]]
+        tracker._reacquire_standing(dataclasses.replace(scan, stamp=90.0), Pose2D())
+        assert [t.track_id for t in tracker._tracks] == ([7] if taken else []), taken
+        assert len(tracker._stood) == (1 if taken else 0)  # furniture's place is forgotten
+
+
 def test_a_passer_by_new_track_keeps_the_candidate_that_is_clearly_theirs():
     # the confirmed person's legs are hidden; the passer-by's candidate lies on their new
     # track and within the person's gate: it stays the passer-by's
