@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_pipeline.py [BAG] [--people 10 50 100] [--hour]
 
-Three parts, each on one core (the process pins itself to its first allowed CPU):
+Its parts, each on one core (the process pins itself to its first allowed CPU):
 
 * **in-process**: on the real recording each scan's time covers reading it (with its
   poses) from the bag and the tracker's step; on the crowd scene (one row per ``--people``)
@@ -16,6 +16,10 @@ Three parts, each on one core (the process pins itself to its first allowed CPU)
   general_tracking_moving_1.bag (873 scans) and training/positive_2.bag (243 scans, same
   laser); the simulated pair is ``follow_outdoor`` with its 86°, 0.35° laser (245 beams),
   150 s and 30 s, written to a temporary folder. Best of three runs each.
+* **start-up**: ``people-tracker --help`` and ``--version`` as a user types them (the console
+  script beside this Python), median and fastest of 15 runs, beside ``python -c pass``: an
+  interpreter start with nothing of ours (with the ``[ros2]`` extra installed, the ROS
+  wheels' ``.pth`` hook re-executes every Python start once to set the library path).
 * ``--hour``: resident memory after 1, 15 and 60 minutes of a simulated crowd (30 people):
   it grows while the place memory fills (``existence.place_memory_s``), then stays flat.
 
@@ -113,6 +117,26 @@ def bench_whole_program() -> None:
         _marginal("follow_outdoor 86 deg, 245 beams (150 s - 30 s)", bags[0], bags[1], out)
 
 
+def bench_startup(runs: int = 15) -> None:
+    """Median and fastest wall time of ``people-tracker --help`` / ``--version``, ms."""
+    import shutil
+
+    script = Path(sys.executable).with_name("people-tracker")
+    script = str(script) if script.exists() else shutil.which("people-tracker")
+    cmds = [("python -c pass (no people-tracker code)", [sys.executable, "-c", "pass"])]
+    if script:
+        cmds += [("people-tracker --help", [script, "--help"]), ("people-tracker --version", [script, "--version"])]
+    else:
+        print("start-up: the people-tracker console script is not installed beside this Python")
+    for name, cmd in cmds:
+        times = []
+        for _ in range(runs):
+            t0 = time.perf_counter()
+            subprocess.run(cmd, capture_output=True, check=True)
+            times.append(1e3 * (time.perf_counter() - t0))
+        print(f"start-up: {name:<40} median {np.median(times):5.0f} ms, fastest {min(times):5.0f} ms")
+
+
 def _rss_mib() -> float:
     """Resident memory of this process now, MiB (Linux; nan elsewhere)."""
     try:
@@ -181,6 +205,7 @@ def main(argv=None) -> int:
         times, per = _best(lambda: bench_crowd(people, config, args.scans))
         _row(f"crowd scene, {people} people (track only)", times, f"{per:.2f}")
     bench_whole_program()
+    bench_startup()
     if args.hour:
         bench_hour(config)
     print(f"peak resident memory: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")

@@ -31,13 +31,9 @@ __all__ = sorted(_API) + ["__version__"]
 
 
 def __getattr__(name: str):
-    if name == "__version__":  # looked up on first use: importlib.metadata takes 20 ms to import
-        from importlib.metadata import PackageNotFoundError, version
+    if name == "__version__":
+        from people_tracker._version import __version__ as value
 
-        try:
-            value = version("people-tracker")
-        except PackageNotFoundError:  # pragma: no cover - running from a source tree without installing
-            value = "0+unknown"
         globals()[name] = value
         return value
     if name in _API:

@@ -7,14 +7,12 @@ bad scans inside a good recording give one warning each and the run goes on.
 from __future__ import annotations
 
 import argparse
-import logging
 import math
 import os
 import re
 import shlex
 import sys
 import time
-from pathlib import Path
 
 from people_tracker.tracker.errors import InputError, require
 
@@ -26,54 +24,16 @@ class _CliError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
+    """One-line errors; ``epilog`` may be a function, called only when the help is shown
+    (the scenario list reads the shipped files: no cost to ``--help`` of other commands)."""
+
     def error(self, message: str):  # one line, exit 2, no usage dump
         raise _CliError(message)
 
-
-class _WarningHandler(logging.Handler):
-    """Warnings on stderr, one line each, written around a live progress bar.
-
-    Warnings alike but for their numbers (a recording with every other scan invalid) are
-    shown ``shown`` times; :meth:`summary` then says how many more there were, once a
-    kind. With ``every`` (``-v``) all are shown.
-    """
-
-    def __init__(self, shown: int = 3, every: bool = False) -> None:
-        super().__init__()
-        self.shown, self.every = shown, every
-        self.counts: dict[str, int] = {}
-        self.first: dict[str, str] = {}
-
-    def emit(self, record: logging.LogRecord) -> None:
-        try:
-            text = record.getMessage()
-            kind = re.sub(r"-?\d+(\.\d+)?", "#", text)
-            self.counts[kind] = self.counts.get(kind, 0) + 1
-            self.first.setdefault(kind, text)
-            if self.every or self.counts[kind] <= self.shown:
-                self._write(f"{PROG}: warning: {text}")
-        except Exception:  # pragma: no cover - logging must never raise
-            self.handleError(record)
-
-    @staticmethod
-    def _write(line: str) -> None:
-        from tqdm import tqdm
-        tqdm.write(line, file=sys.stderr)
-
-    def summary(self) -> None:
-        """One line for each kind of warning shown only in part (once: the counts restart)."""
-        for kind, n in self.counts.items():
-            if not self.every and n > self.shown:
-                self._write(f"{PROG}: warning: ... and {n - self.shown} more like this: {self.first[kind]}")
-        self.counts.clear()
-
-
-def _setup_logging(quiet: bool, verbose: bool) -> _WarningHandler:
-    root = logging.getLogger()
-    handler = _WarningHandler(every=verbose)
-    root.handlers[:] = [handler]
-    root.setLevel(logging.ERROR if quiet else logging.WARNING)
-    return handler
+    def format_help(self) -> str:
+        if callable(self.epilog):
+            self.epilog = self.epilog()
+        return super().format_help()
 
 
 def _volume(parser: argparse.ArgumentParser, default) -> None:
@@ -145,7 +105,7 @@ def _build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
 
     sim = sub.add_parser("simulate", help="render a simulated scenario to a ROS 2 bag (MCAP) with ground truth",
-                         parents=[common], epilog=_scenario_list(), formatter_class=argparse.RawDescriptionHelpFormatter)
+                         parents=[common], epilog=_scenario_list, formatter_class=argparse.RawDescriptionHelpFormatter)
     sim.add_argument("scenario", metavar="SCENARIO", help="a name from configs/scenarios or a YAML file")
     sim.add_argument("--output", required=True, metavar="OUT", help="bag folder to create; ground truth goes to OUT.gt.csv")
     sim.add_argument("--seed", type=int, help="override the scenario's seed")
@@ -295,6 +255,8 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
     from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
     from people_tracker.tracker.scan_checks import ScanChecker
 
+    import logging
+
     log = logging.getLogger(PROG)
     with source as rec, stack:
         det_file = stack.enter_context(atomic_output(args.detections)) if args.detections else None
@@ -406,6 +368,8 @@ def _cmd_evaluate(args) -> int:
     check_outputs([args.tracks, args.ground_truth], [args.json])
     tracks = read_tracks_csv(args.tracks)
     gt = read_ground_truth(args.ground_truth, args.topic, args.gt_topic)
+    import logging
+
     for reason in frame_mismatches(gt, tracks):
         logging.getLogger(PROG).warning(reason)
     if args.target_person is not None and args.protocol != "following":
@@ -444,6 +408,8 @@ def _cmd_bench(args) -> int:
     from people_tracker.tracker.bench import run_bench
     from people_tracker.tracker.config import load_config
 
+    from pathlib import Path
+
     config = load_config(args.config)
     data = Path(args.data or os.environ.get("PEOPLE_TRACKER_DATA") or "../shared/data")
     if args.data and not data.is_dir():
@@ -454,7 +420,7 @@ def _cmd_bench(args) -> int:
 
 def _bag_and_topic(arg: str) -> tuple[str, str | None]:
     """``BAG`` or ``BAG:TOPIC``."""
-    if not Path(arg).exists() and ":" in arg:
+    if not os.path.exists(arg) and ":" in arg:
         bag, topic = arg.rsplit(":", 1)
         return bag, topic
     return arg, None
@@ -540,7 +506,9 @@ def main(argv: list[str] | None = None) -> int:
     except _CliError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
-    handler = _setup_logging(args.quiet, args.verbose and not args.quiet)
+    from people_tracker.tracker.cli_log import setup_logging
+
+    handler = setup_logging(args.quiet, args.verbose and not args.quiet)
     args.argv = list(argv)
     args.ros_args = ["--ros-args", *ros_args[1:]] if ros_args else None
     commands = {"run": _cmd_run, "evaluate": _cmd_evaluate, "simulate": _cmd_simulate, "bench": _cmd_bench,

@@ -116,8 +116,11 @@ def test_repeated_warnings_are_grouped_and_v_shows_them_all(tmp_path):
 
 
 def test_version_and_options_after_the_subcommand():
+    from importlib.metadata import version
+
     from people_tracker import __version__
     assert run_cli("--version").stdout.strip() == f"people-tracker {__version__}"
+    assert __version__ == version("people-tracker")  # the package's version is the installed one's
     proc = run_cli("simulate", "--help")
     for name in ("crossing", "crowd", "room_drive", "case5_lateral"):
         assert f"  {name} " in proc.stdout
@@ -162,3 +165,20 @@ def test_a_failed_run_leaves_no_output(tmp_path):
     (tmp_path / "bad.bag").write_bytes(b"#ROSBAG V2.0\n" + b"\x00" * 500)
     proc = run_cli("run", str(tmp_path / "bad.bag"), "--detections", str(out))
     assert proc.returncode == 2 and not out.exists() and list(tmp_path.iterdir()) == [tmp_path / "bad.bag"]
+
+
+def test_help_and_version_import_nothing_heavy():
+    # the start-up of --help and --version: no numpy, no logging, no package metadata and no
+    # shipped files (the scenario list is read only for `simulate --help`)
+    import subprocess
+    import sys
+
+    code = ("import sys; before = set(sys.modules)\n"
+            "from people_tracker.tracker.cli import main\n"
+            "try:\n    main([sys.argv[1]])\nexcept SystemExit:\n    pass\n"
+            "print(' '.join(sorted(set(sys.modules) - before)))")
+    for flag in ("--help", "--version"):
+        out = subprocess.run([sys.executable, "-c", code, flag], capture_output=True, text=True, check=True).stdout
+        loaded = set(out.strip().splitlines()[-1].split())
+        heavy = {"numpy", "logging", "importlib.metadata", "importlib.resources", "people_tracker.configs", "yaml"}
+        assert not heavy & loaded, (flag, heavy & loaded)
