@@ -247,6 +247,8 @@ def _make_sink(args):
 
 
 def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
+    import logging
+
     import numpy as np
 
     from people_tracker.tracker.config import dump_config
@@ -254,8 +256,6 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
     from people_tracker.tracker.io.atomic import atomic_output
     from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
     from people_tracker.tracker.scan_checks import ScanChecker
-
-    import logging
 
     log = logging.getLogger(PROG)
     with source as rec, stack:
@@ -351,6 +351,7 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
 
 def _cmd_evaluate(args) -> int:
     import json
+    import logging
 
     from people_tracker.tracker.evaluation import evaluate, format_table, frame_mismatches
     from people_tracker.tracker.io.atomic import atomic_output, check_outputs
@@ -368,8 +369,6 @@ def _cmd_evaluate(args) -> int:
     check_outputs([args.tracks, args.ground_truth], [args.json])
     tracks = read_tracks_csv(args.tracks)
     gt = read_ground_truth(args.ground_truth, args.topic, args.gt_topic)
-    import logging
-
     for reason in frame_mismatches(gt, tracks):
         logging.getLogger(PROG).warning(reason)
     if args.target_person is not None and args.protocol != "following":
@@ -405,10 +404,10 @@ def _cmd_simulate(args) -> int:
 
 def _cmd_bench(args) -> int:
     require("motmetrics", "eval", "people-tracker bench")
+    from pathlib import Path
+
     from people_tracker.tracker.bench import run_bench
     from people_tracker.tracker.config import load_config
-
-    from pathlib import Path
 
     config = load_config(args.config)
     data = Path(args.data or os.environ.get("PEOPLE_TRACKER_DATA") or "../shared/data")
