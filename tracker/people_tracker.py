@@ -290,7 +290,8 @@ class PeopleTracker:
             if t.reported and t.moved and t.still and t.place != PlaceMemory.OCCUPIED_ONLY:
                 for e in stood:
                     if e[2] == t.track_id or np.hypot(*(e[0] - t.position)) <= self.assoc.support_anchor_m:
-                        # a track taken up here again began standing: they came when first remembered
+                        # keep when they first came: a track taken up here again (below) began
+                        # standing, so its last move is that re-take, not their arrival
                         e[:] = [t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False,
                                 min(e[5], t.last_moving_update)]
                         break
