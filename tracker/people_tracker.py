@@ -91,6 +91,18 @@ class StepResult:
     leg_scores: np.ndarray | None = None  # ... and the leg model's probability for each
 
 
+@dataclass(eq=False)
+class StoodPlace:
+    """Where someone who walked in stood still (or is guessed to stand, out of sight)."""
+
+    xy: np.ndarray  # world frame, m
+    stamp: float  # last seen there, s
+    track_id: int
+    l_dyn: float  # their accumulated existence evidence, log-odds
+    guess: bool  # only guessed (lost out of sight): what is found there must look like a leg
+    came: float  # when they came (their track last moved), s
+
+
 PASSING_MPS = 0.5  # m/s: a track this fast passing close by someone standing is a passer-by, not them twice
 SET_OFF_S = 3.0  # s: a track this young that began beside someone standing may be them, set off
 TURN_S = 1.0  # s: a walker whose legs were last seen moving this recently may have turned sharply
@@ -123,9 +135,7 @@ class PeopleTracker:
         self.leg_model = leg_model if leg_model is not None else load_leg_model()
         self.existence = existence or ExistenceParams()
         self.places = PlaceMemory(self.existence.place_keyframe_s, self.existence.place_memory_s)
-        # where people who walked in stand still: [xy (world, m), last stamp (s), id, l_dyn,
-        # only a guess (bool), when they came (s: their track last moved)]
-        self._stood: list[list] = []
+        self._stood: list[StoodPlace] = []
         self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
         self._leg_scores = np.zeros(0)  # ... and their leg probabilities
         self._explained: np.ndarray | None = None  # this scan's readings taken by moving candidates given to tracks
@@ -274,7 +284,7 @@ class PeopleTracker:
                                   self.detector.params.no_return_free_m) == OCCLUDED
         for t, xy, h in zip(walkers, middle, hidden):
             if h:
-                self._stood.append([xy, scan.stamp, t.track_id, t.existence.l_dyn, True, t.last_moving_update])
+                self._stood.append(StoodPlace(xy, scan.stamp, t.track_id, t.existence.l_dyn, True, t.last_moving_update))
             t.hidden_position = None  # once per spell out of sight
 
     def _remember_standing(self, scan: Scan, world: Pose2D) -> None:
@@ -283,20 +293,22 @@ class PeopleTracker:
         stamp = scan.stamp
         stood = self._stood
         if stood:
-            xy = np.array([e[0] for e in stood])
+            xy = np.array([e.xy for e in stood])
             vis = place_visibility(xy, scan, world, self.existence.place_radius_m, self.detector.params.no_return_free_m)
-            stood = [e for e, v in zip(stood, vis) if v != SEEN_THROUGH and e[1] >= stamp - self.existence.place_memory_s]
+            stood = [e for e, v in zip(stood, vis) if v != SEEN_THROUGH and e.stamp >= stamp - self.existence.place_memory_s]
         for t in self._tracks:
             if t.reported and t.moved and t.still and t.place != PlaceMemory.OCCUPIED_ONLY:
                 for e in stood:
-                    if e[2] == t.track_id or np.hypot(*(e[0] - t.position)) <= self.assoc.support_anchor_m:
+                    if e.track_id == t.track_id or np.hypot(*(e.xy - t.position)) <= self.assoc.support_anchor_m:
                         # keep when they first came: a track taken up here again (below) began
                         # standing, so its last move is that re-take, not their arrival
-                        e[:] = [t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False,
-                                min(e[5], t.last_moving_update)]
+                        e.xy, e.stamp, e.track_id, e.l_dyn, e.guess = (t.position.copy(), stamp, t.track_id,
+                                                                       t.existence.l_dyn, False)
+                        e.came = min(e.came, t.last_moving_update)
                         break
                 else:
-                    stood.append([t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False, t.last_moving_update])
+                    stood.append(StoodPlace(t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False,
+                                             t.last_moving_update))
         self._stood = stood[-1000:]
 
     def _reacquire_standing(self, scan: Scan, world: Pose2D) -> None:
@@ -308,31 +320,31 @@ class PeopleTracker:
         and the place is forgotten."""
         if not self._stood:
             return
-        clear = self._clear_of_tracks(np.array([e[0] for e in self._stood]))
+        clear = self._clear_of_tracks(np.array([e.xy for e in self._stood]))
         lost = [e for e, c in zip(self._stood, clear) if c]
         if not lost:
             return
-        found = self._static_support(np.array([e[0] for e in lost]), scan, world)
+        found = self._static_support(np.array([e.xy for e in lost]), scan, world)
         used = {t.track_id for t in self._tracks}
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
         furniture = []
         for e, z in zip(lost, found):
-            if z is None or np.hypot(*(z - e[0])) > self.assoc.support_anchor_m:
+            if z is None or np.hypot(*(z - e.xy)) > self.assoc.support_anchor_m:
                 continue
             # where they were only guessed to stand (lost out of sight), the thing found must
             # look at least as leg-like as the leg model's base rate (as for any track back in
             # view): clutter the view clears on is not them
-            if e[4] and not np.nan_to_num(self._best_leg(z[None]))[0] >= self.leg_model.base_rate:
+            if e.guess and not np.nan_to_num(self._best_leg(z[None]))[0] >= self.leg_model.base_rate:
                 continue
             # what the laser saw there, and never saw empty, before they came is furniture (a
             # table leg beside where someone stood keeps the place occupied after they leave)
-            if self._place_history(z, e[5]) == PlaceMemory.OCCUPIED_ONLY:
+            if self._place_history(z, e.came) == PlaceMemory.OCCUPIED_ONLY:
                 furniture.append(e)
                 continue
-            e[4] = False
+            e.guess = False
             ex = Existence(self.existence, scan.stamp, True, True, None, self.leg_model.base_rate)
-            ex.l_dyn = e[3]
-            track_id = e[2] if e[2] not in used else self._next_id
+            ex.l_dyn = e.l_dyn
+            track_id = e.track_id if e.track_id not in used else self._next_id
             if track_id == self._next_id:
                 self._next_id += 1
             t = TrackState(track_id, float(z[0]), float(z[1]), R, scan.stamp, self.track_params, ex, standing=True)
@@ -340,9 +352,9 @@ class PeopleTracker:
             t.last_moving_update = t.last_update - self.track_params.still_after_s  # standing still
             self._tracks.append(t)
             used.add(track_id)
-            e[2] = track_id
+            e.track_id = track_id
         if furniture:
-            self._stood = [e for e in self._stood if not any(e is f for f in furniture)]
+            self._stood = [e for e in self._stood if e not in furniture]  # by identity (eq=False)
 
     def _place_history(self, xy: np.ndarray, since: float) -> str:
         e = self.existence

@@ -9,7 +9,7 @@ from people_tracker.models.scenario import build_simulation
 from people_tracker.tracker.config import load_config
 from people_tracker.tracker.following import TargetSelector
 from people_tracker.tracker.pairing import PersonCandidate
-from people_tracker.tracker.people_tracker import PeopleTracker
+from people_tracker.tracker.people_tracker import PeopleTracker, StoodPlace
 from people_tracker.tracker.static_support import static_support
 
 LASER = {"fov_deg": 270, "resolution_deg": 0.35, "rate_hz": 10, "range_max": 20, "noise_std": 0.0}
@@ -255,7 +255,7 @@ def test_where_someone_stood_furniture_that_was_there_before_them_does_not_take_
         for stamp in np.arange(-30.0, 0.0, 1.0):  # half a minute of keyframes before they came at 0 s
             tracker.places.add(dataclasses.replace(before, stamp=float(stamp)), Pose2D())
         # id 7 stood there from 0 s on (evidence 3, log-odds), last seen there at 60 s
-        tracker._stood = [[np.array([3.0, 0.0]), 60.0, 7, 3.0, False, 0.0]]
+        tracker._stood = [StoodPlace(np.array([3.0, 0.0]), 60.0, 7, 3.0, False, 0.0)]
         tracker._reacquire_standing(dataclasses.replace(scan, stamp=90.0), Pose2D())
         assert [t.track_id for t in tracker._tracks] == ([7] if taken else []), taken
         assert len(tracker._stood) == (1 if taken else 0)  # furniture's place is forgotten

@@ -364,7 +364,7 @@ def test_a_walker_who_vanishes_behind_someone_is_remembered_where_they_may_stand
         if stamp < 2.0:
             assert not tracker._stood and t.hidden_position is not None
     assert len(tracker._stood) == 1
-    xy, _, track_id, l_dyn, guess, _ = tracker._stood[0]
+    xy, track_id, guess = tracker._stood[0].xy, tracker._stood[0].track_id, tracker._stood[0].guess
     assert track_id == t.track_id and guess
     # the middle of 3.0,0.5 (last seen) .. 3.0,1.5 (the last prediction that was hidden)
     assert xy == pytest.approx([3.0, 1.0], abs=1e-9)
