@@ -16,6 +16,7 @@ line's ``--help`` stay fast.
 
 from __future__ import annotations
 
+import os as _os
 from importlib import import_module
 
 _API = {
@@ -28,6 +29,15 @@ _API = {
 }
 
 __all__ = sorted(_API) + ["__version__"]
+
+# In a source checkout the subpackages sit beside this folder (pyproject.toml's package-dir maps
+# tracker/ to people_tracker.tracker, and so on). When Python takes this folder from the checkout
+# itself (``python -c``/``python -m people_tracker`` run in the checkout's root, which shadows an
+# installed copy), the subpackages are looked up there too, so the checkout imports whole.
+_checkout = _os.path.dirname(_os.path.dirname(_os.path.abspath(__file__)))
+if _os.path.isfile(_os.path.join(_checkout, "pyproject.toml")) and _os.path.isdir(_os.path.join(_checkout, "tracker")):
+    __path__.append(_checkout)
+del _checkout
 
 
 def __getattr__(name: str):

@@ -167,9 +167,10 @@ def test_a_failed_run_leaves_no_output(tmp_path):
     assert proc.returncode == 2 and not out.exists() and list(tmp_path.iterdir()) == [tmp_path / "bad.bag"]
 
 
-def test_help_and_version_import_nothing_heavy():
+def test_help_and_version_import_nothing_heavy(tmp_path):
     # the start-up of --help and --version: no numpy, no logging, no package metadata and no
-    # shipped files (the scenario list is read only for `simulate --help`)
+    # shipped files (the scenario list is read only for `simulate --help`); run away from the
+    # checkout so that the installed package is the one measured
     import subprocess
     import sys
 
@@ -178,7 +179,30 @@ def test_help_and_version_import_nothing_heavy():
             "try:\n    main([sys.argv[1]])\nexcept SystemExit:\n    pass\n"
             "print(' '.join(sorted(set(sys.modules) - before)))")
     for flag in ("--help", "--version"):
-        out = subprocess.run([sys.executable, "-c", code, flag], capture_output=True, text=True, check=True).stdout
+        out = subprocess.run([sys.executable, "-c", code, flag], capture_output=True, text=True, check=True,
+                             cwd=tmp_path).stdout
         loaded = set(out.strip().splitlines()[-1].split())
         heavy = {"numpy", "logging", "importlib.metadata", "importlib.resources", "people_tracker.configs", "yaml"}
         assert not heavy & loaded, (flag, heavy & loaded)
+
+
+def test_a_source_checkout_imports_whole_from_its_root():
+    # `python -c`/`-m people_tracker` in the checkout's root takes people_tracker/ from the
+    # checkout, shadowing the installed copy; its subpackages (tracker/, models/, ... beside it)
+    # must come with it. A development install's finder would map them anyway, so it is removed.
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    code = ("import sys\n"
+            "sys.meta_path[:] = [f for f in sys.meta_path if 'editable' not in repr(f).lower()\n"
+            "                    and 'editable' not in type(f).__module__.lower()]\n"
+            "import people_tracker.tracker.cli as cli, people_tracker.models.pose as pose\n"
+            "print(cli.__file__); print(pose.__file__)\n"
+            "cli.main(['--version'])")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root)
+    assert proc.returncode == 0, proc.stderr
+    cli_file, pose_file, version = proc.stdout.splitlines()[:3]
+    assert Path(cli_file) == root / "tracker" / "cli.py" and Path(pose_file) == root / "models" / "pose.py"
+    assert version.startswith("people-tracker ")
