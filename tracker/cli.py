@@ -142,6 +142,9 @@ def _build_parser() -> argparse.ArgumentParser:
     ros.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
     ros.add_argument("--follow", metavar="auto|ID", help="follow a person: the closest ahead (auto) or a track id")
     ros.add_argument("--legs", action="store_true", help="also publish the likely leg candidates on legs")
+    ros.add_argument("--queue", type=int, default=10, metavar="N",
+                     help="scans waiting to be tracked before the oldest is dropped (%(default)s); more trades "
+                          "latency for every scan, e.g. for a recording replayed faster than it was made")
     rp = sub.add_parser("replay", help="publish a recording's scans and odometry on ROS 2 ([ros2] extra)",
                         parents=[common])
     rp.add_argument("input", metavar="INPUT", help="a ROS 1 .bag, a ROS 2 bag folder, or an .mcap file")
@@ -481,8 +484,10 @@ def _cmd_ros2(args) -> int:
     x, y, yaw_deg = args.mount
     if not all(_math.isfinite(v) for v in args.mount):
         raise InputError("--mount takes three finite numbers: X Y YAW_DEG")
+    if args.queue < 1:
+        raise InputError(f"--queue takes a number of scans, 1 or more, got {args.queue}")
     options = NodeOptions(args.scan_topic, "" if args.no_odom else args.odom_topic, (x, y, _math.radians(yaw_deg)),
-                          args.fixed_frame, args.follow or "", args.legs)
+                          args.fixed_frame, args.follow or "", args.legs, args.queue)
     return run_node(options, config, args.ros_args)
 
 

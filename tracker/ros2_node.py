@@ -103,7 +103,10 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
         "fixed_frame": node.declare_parameter("fixed_frame", options.fixed_frame).value,
         "follow": node.declare_parameter("follow", options.follow).value,
         "legs": node.declare_parameter("legs", options.legs).value,
+        "queue": node.declare_parameter("queue", options.queue).value,
     }
+    if not isinstance(p["queue"], int) or isinstance(p["queue"], bool) or p["queue"] < 1:
+        raise InputError(f"parameter 'queue' must be a whole number of scans, 1 or more, got {p['queue']!r}")
     if len(p["mount"]) != 3:
         raise InputError("parameter 'mount' must be [x, y, yaw_deg]")
     mount = Pose2D(float(p["mount"][0]), float(p["mount"][1]), math.radians(float(p["mount"][2])))
@@ -134,7 +137,7 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
         now = time.perf_counter()
         with lock:
             state["last_scan"], state["silent_warned"] = now, False
-            if len(pending) >= max(1, options.queue):
+            if len(pending) >= p["queue"]:
                 pending.popleft()
                 state["dropped"] += 1
                 if now - state["last_drop_warn"] >= 1.0:

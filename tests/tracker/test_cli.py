@@ -206,3 +206,8 @@ def test_a_source_checkout_imports_whole_from_its_root():
     cli_file, pose_file, version = proc.stdout.splitlines()[:3]
     assert Path(cli_file) == root / "tracker" / "cli.py" and Path(pose_file) == root / "models" / "pose.py"
     assert version.startswith("people-tracker ")
+
+
+def test_a_ros2_queue_below_one_scan_is_refused_before_ros_starts():
+    proc = run_cli("ros2", "--queue", "0")
+    assert_one_line_error(proc, "--queue")
