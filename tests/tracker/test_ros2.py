@@ -57,7 +57,11 @@ LISTENER = textwrap.dedent('''
 ''')
 
 
-def _env(domain: int) -> dict:
+def _env(test: int) -> dict:
+    """A ROS domain of the test's own: even for test 0, odd for test 1 (so two tests that run
+    at once, in two pytest workers, never share one), and by the process id, so two runs of
+    the suite on one machine rarely do."""
+    domain = 40 + 2 * (os.getpid() % 25) + test
     return {**os.environ, "ROS_DOMAIN_ID": str(domain), "PYTHONUNBUFFERED": "1"}
 
 
@@ -81,7 +85,7 @@ def test_the_node_publishes_what_the_offline_run_writes(tmp_path, moving_bag):
     """873 scans replayed at 4x with their odometry: every scan tracked, none dropped (a queue
     long enough for all, so however slow the machine), and the people (ids and fixed-frame
     positions) are those of `people-tracker run --tracks`."""
-    env = _env(40 + os.getpid() % 50)
+    env = _env(0)
     offline = tmp_path / "offline.csv"
     assert subprocess.run(cli_command() + ["-q", "run", str(moving_bag), "--tracks", str(offline)], env=env,
                           capture_output=True, timeout=300).returncode == 0
@@ -158,7 +162,7 @@ BAD = textwrap.dedent('''
 
 
 def test_bad_messages_are_handled_as_the_offline_reader_handles_them(tmp_path):
-    env = _env(40 + (os.getpid() + 25) % 50)
+    env = _env(1)
     node = _start_node(env)
     bad = subprocess.run([sys.executable, "-c", BAD], env=env, capture_output=True, text=True, timeout=60)
     assert bad.returncode == 0 and "sent" in bad.stdout, bad.stderr
