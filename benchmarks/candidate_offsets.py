@@ -14,11 +14,14 @@ This is the measurement behind the position error of the following scenes
 
 Usage::
 
-    python benchmarks/candidate_offsets.py
+    python benchmarks/candidate_offsets.py [--scene NAME_OR_YAML --laser LASER --duration S]
+
+With ``--scene``, that scene alone (a shipped name or a scenario YAML file).
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
 
 import numpy as np
@@ -75,14 +78,20 @@ def rotate(v: np.ndarray, yaw: float) -> np.ndarray:
     return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
 
 
-def main() -> int:
-    print(f"{'scene':<38} {'kind':<5} {'cands':>6} {'radial m':>9} {'sd m':>6} {'along m':>8}   "
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scene", help="one scene (a shipped name or a scenario YAML file) instead of the four")
+    ap.add_argument("--laser", help="with --scene: the laser (default: the scene's)")
+    ap.add_argument("--duration", type=float, help="with --scene: seconds (default: the scene's)")
+    args = ap.parse_args(argv)
+    scenes = SCENES if args.scene is None else ((args.scene, args.laser, args.duration),)
+    print(f"{'scene':<44} {'kind':<5} {'cands':>6} {'radial m':>9} {'sd m':>6} {'along m':>8}   "
           f"radial m by |cos(walk, beam)| {' / '.join(f'{a:g}-{b:g}' for a, b in COS_BINS)}")
-    for scene, laser, duration in SCENES:
+    for scene, laser, duration in scenes:
         rows = offsets(scene, laser, duration)
         kinds = np.array([r[0] for r in rows], dtype=object)
         values = np.array([r[1:] for r in rows]).reshape(-1, 3)
-        label = scene + (f" ({laser}, {duration:g} s)" if laser else "")
+        label = scene + (f" ({laser}, {duration:g} s)" if laser and duration else f" ({laser})" if laser else "")
         for kind in ("pair", "leg", "blob"):
             m = kinds == kind
             if m.sum() < 10:
@@ -92,7 +101,7 @@ def main() -> int:
             for a, b in COS_BINS:
                 sel = (cos >= a) & (cos < b) if b < 1.0 else (cos >= a)
                 by_cos.append(f"{radial[sel].mean():+.3f} ({sel.sum()})" if sel.sum() >= 10 else "-")
-            print(f"{label:<38} {kind:<5} {m.sum():>6} {radial.mean():>+9.3f} {radial.std():>6.3f} "
+            print(f"{label:<44} {kind:<5} {m.sum():>6} {radial.mean():>+9.3f} {radial.std():>6.3f} "
                   f"{along.mean():>+8.3f}   {' / '.join(by_cos)}", flush=True)
     return 0
 
