@@ -35,7 +35,8 @@ __all__ = sorted(_API) + ["__version__"]
 # itself (``python -c``/``python -m people_tracker`` run in the checkout's root, which shadows an
 # installed copy), the subpackages are looked up there too, so the checkout imports whole.
 _checkout = _os.path.dirname(_os.path.dirname(_os.path.abspath(__file__)))
-if _os.path.isfile(_os.path.join(_checkout, "pyproject.toml")) and _os.path.isdir(_os.path.join(_checkout, "tracker")):
+if (_os.path.isfile(_os.path.join(_checkout, "pyproject.toml"))
+        and _os.path.isfile(_os.path.join(_checkout, "tracker", "people_tracker.py"))):  # never site-packages
     __path__.append(_checkout)
 del _checkout
 
