@@ -74,6 +74,21 @@ class _Pending:
         return self._decoded
 
 
+
+def _declare_parameters(node, options: NodeOptions) -> dict:
+    """The node's options as ROS parameters (a launch file or --ros-args -p name:=value sets them)."""
+    return {
+        "scan_topic": node.declare_parameter("scan_topic", options.scan_topic).value,
+        "odom_topic": node.declare_parameter("odom_topic", options.odom_topic).value,
+        "mount": list(node.declare_parameter("mount", [float(options.mount[0]), float(options.mount[1]),
+                                                          math.degrees(options.mount[2])]).value),
+        "fixed_frame": node.declare_parameter("fixed_frame", options.fixed_frame).value,
+        "follow": node.declare_parameter("follow", options.follow).value,
+        "legs": node.declare_parameter("legs", options.legs).value,
+        "queue": node.declare_parameter("queue", options.queue).value,
+    }
+
+
 def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) -> int:
     """Run the node until SIGINT (or the context shuts down); returns the exit status 0."""
     rclpy = require("rclpy", "ros2", "people-tracker ros2 (the ROS 2 node)")
@@ -94,17 +109,12 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
 
     rclpy.init(args=ros_args)
     node = Node("people_tracker")
-    # the options are ROS parameters too (a launch file or --ros-args -p name:=value sets them)
-    p = {
-        "scan_topic": node.declare_parameter("scan_topic", options.scan_topic).value,
-        "odom_topic": node.declare_parameter("odom_topic", options.odom_topic).value,
-        "mount": list(node.declare_parameter("mount", [float(options.mount[0]), float(options.mount[1]),
-                                                          math.degrees(options.mount[2])]).value),
-        "fixed_frame": node.declare_parameter("fixed_frame", options.fixed_frame).value,
-        "follow": node.declare_parameter("follow", options.follow).value,
-        "legs": node.declare_parameter("legs", options.legs).value,
-        "queue": node.declare_parameter("queue", options.queue).value,
-    }
+    from rclpy.exceptions import NameValidationException, ParameterException
+
+    try:
+        p = _declare_parameters(node, options)
+    except ParameterException as exc:  # a value of the wrong type (-p legs:=maybe): a bad configuration
+        raise InputError(f"ROS parameter: {' '.join(str(exc).split())}") from None
     if not isinstance(p["queue"], int) or isinstance(p["queue"], bool) or p["queue"] < 1:
         raise InputError(f"parameter 'queue' must be a whole number of scans, 1 or more, got {p['queue']!r}")
     if len(p["mount"]) != 3:
@@ -161,9 +171,12 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
                 state["silent_warned"] = True
                 log.warning("no scan on %s for %.0f s", p["scan_topic"], NO_SCAN_WARN_S)
 
-    node.create_subscription(LaserScan, p["scan_topic"], on_scan, qos_profile_sensor_data)
-    if p["odom_topic"]:
-        node.create_subscription(Odometry, p["odom_topic"], on_odom, QoSProfile(depth=200))
+    try:
+        node.create_subscription(LaserScan, p["scan_topic"], on_scan, qos_profile_sensor_data)
+        if p["odom_topic"]:
+            node.create_subscription(Odometry, p["odom_topic"], on_odom, QoSProfile(depth=200))
+    except NameValidationException as exc:  # --scan-topic "front scan"
+        raise InputError(f"topic name: {' '.join(str(exc).split())}") from None
     node.create_timer(0.5, on_timer)
 
     def header(stamp_msg, frame: str):

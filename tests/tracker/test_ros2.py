@@ -19,7 +19,7 @@ import time
 import numpy as np
 import pytest
 
-from tests_helpers import cli_command
+from tests_helpers import assert_one_line_error, cli_command
 
 pytest.importorskip("rclpy", reason="the [ros2] extra (ros-rclpy and the message wheels) is not installed")
 
@@ -173,3 +173,11 @@ def test_bad_messages_are_handled_as_the_offline_reader_handles_them(tmp_path):
     assert "beam" in err, err
     # 60 scans: the empty one, the all-invalid one and the two with a new beam count are skipped
     assert "56 scans tracked, 0 dropped" in out, out
+
+
+@pytest.mark.parametrize("args, says", [(["--ros-args", "-p", "legs:=maybe"], "ROS parameter"),
+                                        (["--ros-args", "-p", "queue:=0"], "queue"),
+                                        (["--scan-topic", "front#scan"], "topic name")])
+def test_a_bad_ros_parameter_or_topic_is_one_line_and_exit_2(args, says):
+    proc = subprocess.run(cli_command() + ["ros2", *args], env=_env(1), capture_output=True, text=True, timeout=60)
+    assert_one_line_error(proc, says)
