@@ -365,6 +365,8 @@ def replay(path: str, topic: str | None, rate: float, config, wait_s: float = 5.
 
     if not (rate > 0 and math.isfinite(rate)):
         raise InputError(f"--rate must be a positive number, got {rate!r}")
+    if not (wait_s >= 0 and math.isfinite(wait_s)):
+        raise InputError(f"--wait must be 0 or more seconds, got {wait_s!r}")
     with Recording(path, topic, config.odometry) as rec:
         source = rec.pose_source
         odom_conns = list(source.connections) if isinstance(source, OdomTopicSource) else []
@@ -382,16 +384,20 @@ def replay(path: str, topic: str | None, rate: float, config, wait_s: float = 5.
         pub_scan = node.create_publisher(LaserScan, scan_topic, qos)
         pub_odom = node.create_publisher(Odometry, odom_topic, qos) if odom_topic else None
         deadline = time.monotonic() + wait_s
-        while pub_scan.get_subscription_count() == 0 and time.monotonic() < deadline:
-            time.sleep(0.05)
-        if pub_scan.get_subscription_count():
-            time.sleep(0.5)  # the subscriber's side of the match settles too: best-effort scans sent before are lost
         reader = rec._reader
         scan_ids = {c.id for c in rec._scan_conns}
         start_wall = first_bag = None
         n_scans = n_odom = 0
+        interrupted = False
         try:
+            while pub_scan.get_subscription_count() == 0 and time.monotonic() < deadline and rclpy.ok():
+                time.sleep(0.05)
+            if pub_scan.get_subscription_count():
+                time.sleep(0.5)  # the subscriber's side of the match settles too: best-effort scans sent before are lost
             for conn, bag_time, raw in reader.messages(connections=list(rec._scan_conns) + odom_conns):
+                if not rclpy.ok():  # SIGTERM (rclpy shut the context down): stop, as for Ctrl-C
+                    interrupted = True
+                    break
                 if start_wall is None:
                     start_wall, first_bag = time.monotonic(), bag_time
                 due = start_wall + (bag_time - first_bag) * 1e-9 / rate
@@ -406,17 +412,20 @@ def replay(path: str, topic: str | None, rate: float, config, wait_s: float = 5.
                         pub_odom.publish(_ros_odom(reader.deserialize(raw, ODOMETRY), Odometry, Header, Time))
                         n_odom += 1
                 except Exception as exc:
+                    if not rclpy.ok():  # shut down while it slept: stopped, not a bad message
+                        interrupted = True
+                        break
                     log.warning("a message on %s could not be republished: %s", conn.topic,
                                 " ".join(str(exc).split())[:160])
         except KeyboardInterrupt:
-            pass
+            interrupted = True
         finally:
             time.sleep(0.2)  # let the last messages leave
             node.destroy_node()
             rclpy.try_shutdown()
-    print(f"replayed {n_scans} scans on {scan_topic}" + (f" and {n_odom} odometry messages on {odom_topic}"
-                                                         if odom_topic else "") + f" at {rate:g}x", flush=True)
-    return 0
+    print(("stopped: " if interrupted else "") + f"replayed {n_scans} scans on {scan_topic}"
+          + (f" and {n_odom} odometry messages on {odom_topic}" if odom_topic else "") + f" at {rate:g}x", flush=True)
+    return 130 if interrupted else 0
 
 
 __all__ = ["NodeOptions", "replay", "run_node"]

@@ -181,3 +181,23 @@ def test_bad_messages_are_handled_as_the_offline_reader_handles_them(tmp_path):
 def test_a_bad_ros_parameter_or_topic_is_one_line_and_exit_2(args, says):
     proc = subprocess.run(cli_command() + ["ros2", *args], env=_env(1), capture_output=True, text=True, timeout=60)
     assert_one_line_error(proc, says)
+
+
+def test_replay_refuses_a_negative_wait(negative_bag):
+    proc = subprocess.run(cli_command() + ["replay", str(negative_bag), "--topic", "/rear_scan", "--wait", "-1"],
+                          env=_env(1), capture_output=True, text=True, timeout=60)
+    assert_one_line_error(proc, "--wait")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_replay_stops_on_a_signal_and_says_so(negative_bag, sig):
+    # 58 s of recording at its own pace: a signal after the start ends it at once, status 130,
+    # with no warning about messages it could not send after ROS shut down
+    proc = subprocess.Popen(cli_command() + ["replay", str(negative_bag), "--topic", "/rear_scan", "--wait", "0"],
+                            env=_env(1), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert "no odometry topic" in proc.stdout.readline()
+    time.sleep(1.0)
+    proc.send_signal(sig)
+    out, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, (proc.returncode, out, err)
+    assert "stopped: replayed" in out and "could not be republished" not in err, (out, err)
