@@ -26,6 +26,7 @@ import sys
 
 import numpy as np
 
+from people_tracker.models.pose import Pose2D
 from people_tracker.tracker.config import load_config
 from people_tracker.tracker.io.simulated import SimulatedSource
 from people_tracker.tracker.people_tracker import PeopleTracker
@@ -46,11 +47,11 @@ def offsets(scene: str, laser: str | None, duration: float | None) -> list[tuple
     for record in source.scans():
         tracker.step(record.scan, record.pose, record.pose_last_beam)
         truth = source.truths[record.index]
-        yaw = truth.sensor_pose.yaw
+        turn = Pose2D(0.0, 0.0, -truth.sensor_pose.yaw)  # world directions into the sensor frame
         walk = {}  # person id -> velocity in the sensor frame, m/s
         for pid, xy in zip(truth.person_id.tolist(), truth.torso_world):
             if pid in previous and truth.stamp > previous[pid][1]:
-                walk[pid] = rotate((xy - previous[pid][0]) / (truth.stamp - previous[pid][1]), -yaw)
+                walk[pid] = turn.transform_points((xy - previous[pid][0])[None] / (truth.stamp - previous[pid][1]))[0]
             previous[pid] = (xy.copy(), truth.stamp)
         seen = truth.visible
         if not seen.any() or not tracker.last.candidates:
@@ -69,13 +70,6 @@ def offsets(scene: str, laser: str | None, duration: float | None) -> list[tuple
             off = q - people[j]
             out.append((c.kind, float(off @ beam), float(off @ heading), float(abs(beam @ heading))))
     return out
-
-
-def rotate(v: np.ndarray, yaw: float) -> np.ndarray:
-    """The vector ``v`` turned by ``yaw`` radians (with minus the sensor's heading: a world
-    direction in the sensor frame)."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
 
 
 def main(argv=None) -> int:
