@@ -46,6 +46,9 @@ class PairingParams:
         depth must exceed a flat surface's thickness in the laser's noise for the rule to
         act (with a noisier laser it acts less, never on people); at 2 cm it took some of a
         simulated crowd's leg pairs seen as one object for walls. 0 turns it off.
+    stance_partner : bool
+        Pair a walking person's lone moving leg with their standing leg, a still
+        leg-shaped segment beside it (see ``PeopleTracker._stance_partners``).
     """
 
     min_leg_size_m: float = 0.04
@@ -58,6 +61,7 @@ class PairingParams:
     max_leg_radius_m: float = 0.08
     flat_min_length_m: float = 0.16
     flat_max_depth_m: float = 0.015
+    stance_partner: bool = True
 
 
 @dataclass(frozen=True, eq=False)

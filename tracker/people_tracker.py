@@ -182,16 +182,16 @@ class PeopleTracker:
                                          aligned.tree)
         for t in self._tracks:  # 2. predict every track to the scan time
             t.predict(scan.stamp)
-        candidates = self._candidates(detection, world)  # 3. legs paired into people (world frame)
+        legs = leg_candidates(scan)  # every leg candidate and its probability, by shape alone
+        leg_scores = self.leg_model.probability(legs.features)
+        candidates = self._candidates(detection, world, legs, leg_scores)  # 3. legs paired into people (world frame)
         matched = self._associate(candidates)  # 4. associate candidates to tracks
         matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
         for ti, ci in matched:  # 5. update the matched tracks
             c = candidates[ci]
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
         self._explained = self._explained_readings(detection, [candidates[ci] for _, ci in matched], scan.n_beams)
-        legs = leg_candidates(scan)  # 6. every leg candidate and its probability, by shape alone
-        leg_scores = self.leg_model.probability(legs.features)
-        self._unmatchable_legs(scan, legs, leg_scores)
+        self._unmatchable_legs(scan, legs, leg_scores)  # 6. leg-shaped readings
         self._legs_world = world.transform_points(legs.xy) if len(legs.xy) else np.zeros((0, 2))
         self._leg_scores = leg_scores
         standing = self._standing_candidates(scan, legs, leg_scores, world)  # 6b. standing people: leg pairs
@@ -371,7 +371,8 @@ class PeopleTracker:
                 "(PeopleTracker.bad_poses counts them)", stamp)
         return None
 
-    def _candidates(self, detection: Detection, world: Pose2D) -> list[PersonCandidate]:
+    def _candidates(self, detection: Detection, world: Pose2D, legs: LegCandidates,
+                    leg_scores: np.ndarray) -> list[PersonCandidate]:
         objs = detection.objects
         if not objs:
             return []
@@ -385,8 +386,58 @@ class PeopleTracker:
         # person's. A person standing still owns no moving legs: those are a passer-by's.
         people = np.array([t.position for t in self._tracks if t.confirmed and not t.still]).reshape(-1, 2)
         groups = owners(xy, people, self._half_stride_m)
-        return pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups,
-                         np.array([o.width for o in objs]))
+        out = pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups,
+                        np.array([o.width for o in objs]))
+        return self._stance_partners(out, detection, world, legs, leg_scores, xy, groups, people)
+
+    def _stance_partners(self, candidates: list[PersonCandidate], detection: Detection, world: Pose2D,
+                         legs: LegCandidates, leg_scores: np.ndarray, xy: np.ndarray, groups: np.ndarray,
+                         people: np.ndarray) -> list[PersonCandidate]:
+        """A walker's lone moving leg, paired with their standing leg.
+
+        While one leg swings the other stands on the floor, still, and is no moving object:
+        the swinging leg alone lies up to half a stride from the torso. A lone moving leg
+        owned by a walking track (see :func:`owners`), with a still leg-shaped segment of
+        this scan (leg probability at least ``start_leg_probability``) between two leg
+        radii and a stride from it, owned by no other walker, whose midpoint with the leg
+        lies nearer the track's prediction than the leg does, is that person's leg pair:
+        the candidate moves to the midpoint, with a leg pair's uncertainty. Nothing else
+        changes: a leg no walking track owns is left alone (furniture beside a passer-by
+        starts nobody)."""
+        lone = [k for k, c in enumerate(candidates) if c.kind == "leg"] if self.pairing.stance_partner else []
+        keep = leg_scores >= self.assoc.start_leg_probability
+        if not lone or not keep.any() or not len(people):
+            return candidates
+        moving = np.zeros(detection.labels.shape, dtype=bool)
+        for o in detection.objects:
+            moving[o.beams] = True
+        still = keep & np.array([not moving[a:b + 1].any() for a, b in zip(legs.first_beam, legs.last_beam)])
+        if not still.any():
+            return candidates
+        widths = legs.features[still, 1]
+        s_xy = world.transform_points(leg_centres(legs.xy[still], widths, self.pairing.max_leg_radius_m))
+        s_own = owners(s_xy, people, self._half_stride_m)
+        index = {o.object_id: i for i, o in enumerate(detection.objects)}
+        out = list(candidates)
+        taken: set[int] = set()
+        for k in lone:
+            i = index[candidates[k].object_ids[0]]
+            g = groups[i]
+            if g < 0:
+                continue
+            d = np.hypot(*(s_xy - xy[i]).T)
+            ok = ((d >= 2.0 * self.pairing.max_leg_radius_m) & (d <= self.pairing.max_leg_separation_m)
+                  & ((s_own < 0) | (s_own == g)))
+            mids = 0.5 * (s_xy + xy[i])
+            ok &= np.hypot(*(mids - people[g]).T) < np.hypot(*(xy[i] - people[g]))
+            ok[list(taken)] = False
+            if not ok.any():
+                continue
+            j = int(np.flatnonzero(ok)[np.argmin(d[ok])])
+            taken.add(j)
+            out[k] = PersonCandidate(float(mids[j, 0]), float(mids[j, 1]), self.pairing.sigma_pair_m, "pair",
+                                     candidates[k].object_ids)
+        return out
 
     def _associate(self, candidates: list[PersonCandidate]) -> list[tuple[int, int]]:
         if not self._tracks or not candidates:

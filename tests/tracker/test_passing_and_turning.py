@@ -274,3 +274,61 @@ def test_a_new_track_gives_way_to_a_confirmed_one_when_in_doubt():
     # doubt -2 ln 0.2 = 3.2): the confirmed person's
     tracker = _two_tracks((2.65, 0.0), other_born_s=0.2, other_confirmed=False)
     assert tracker._associate([PersonCandidate(2.5, 0.0, 0.08, "leg")]) == [(0, 0)]
+
+
+def _lone_leg_case(prediction, owner=0, partner_score=0.9):
+    """A scan with a walker's two legs (pillars at (3, 0) and (3, -0.4)); the one at y = 0
+    is their lone moving leg, the other stands still; the walker's track is predicted at
+    ``prediction`` and owns the moving leg when ``owner`` is 0."""
+    from types import SimpleNamespace
+
+    from people_tracker.detection.detector import Detection
+    from people_tracker.detection.leg_features import leg_candidates
+
+    scan = _scan([[3.0, 0.0, 0.06], [3.0, -0.4, 0.06]])
+    legs = leg_candidates(scan)
+    swinging = int(np.argmin(np.abs(legs.xy[:, 1])))
+    moving = SimpleNamespace(object_id=7, beams=np.arange(legs.first_beam[swinging], legs.last_beam[swinging] + 1))
+    detection = Detection(np.zeros(scan.n_beams, dtype=np.int8), [moving], ())
+    lone = PersonCandidate(3.05, 0.0, 0.2, "leg", (7,))
+    tracker = PeopleTracker.from_config(load_config())
+    return tracker._stance_partners([lone], detection, Pose2D(), legs, np.full(len(legs), partner_score),
+                                    np.array([[3.05, 0.0]]), np.array([owner]), np.array([prediction], dtype=float))[0]
+
+
+def test_a_walkers_lone_moving_leg_pairs_with_their_standing_leg():
+    c = _lone_leg_case([3.05, -0.2])  # the track expects the torso between the two legs
+    assert c.kind == "pair" and c.object_ids == (7,)
+    assert abs(c.x - 3.05) < 0.03 and abs(c.y + 0.2) < 0.03  # the two leg centres' midpoint
+    assert c.sigma < 0.2
+
+
+def test_a_lone_moving_leg_keeps_its_place_when_the_partner_leads_away_from_the_track():
+    assert _lone_leg_case([3.05, 0.3]).kind == "leg"  # the still leg lies on the far side of the prediction
+    assert _lone_leg_case([3.05, -0.2], owner=-1).kind == "leg"  # nobody's leg: nothing is paired
+    assert _lone_leg_case([3.05, -0.2], partner_score=0.1).kind == "leg"  # the still thing is no leg
+
+
+def test_stance_partners_bring_a_walkers_lone_legs_nearer_the_torso():
+    """Over a walk across the view, the candidates made of one moving leg lie nearer the
+    torso with the standing leg as partner (``pairing.stance_partner``) than without. (The
+    bare simulated room gives its legs leg probabilities of 0.1-0.45, so what counts as
+    leg-shaped is lowered for both runs.)"""
+    from people_tracker.tracker.config import config_from_dict
+
+    spec = {"duration_s": 8.0, "laser": LASER, "world": {"room": [-1, -6, 9, 6]},
+            "people": [{"id": 1, "path": [[4.0, -4.0], [4.0, 4.0]], "speed": 1.2}]}
+    errors = {}
+    for on in (False, True):
+        sim, n = build_simulation(spec)
+        tracker = PeopleTracker.from_config(config_from_dict({"pairing": {"stance_partner": on},
+                                                              "association": {"start_leg_probability": 0.1}}))
+        err = []
+        for _ in range(n):
+            st = sim.step()
+            tracker.step(st.scan, st.odom_pose @ sim.mount)
+            torso = st.truth.torso_world[0]
+            err += [np.hypot(c.x - torso[0], c.y - torso[1]) for c in tracker.last.candidates
+                    if len(c.object_ids) == 1 and c.kind in ("leg", "pair") and np.hypot(c.x - torso[0], c.y - torso[1]) < 0.8]
+        errors[on] = float(np.mean(err))
+    assert errors[True] < errors[False] - 0.02, errors
