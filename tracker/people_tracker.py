@@ -384,29 +384,30 @@ class PeopleTracker:
             xy = world.transform_points(np.array([(o.x, o.y) for o in objs]))
         # legs near a tracked walking person are that person's: never paired with another
         # person's. A person standing still owns no moving legs: those are a passer-by's.
-        people = np.array([t.position for t in self._tracks if t.confirmed and not t.still]).reshape(-1, 2)
-        groups = owners(xy, people, self._half_stride_m)
+        walking = [t for t in self._tracks if t.confirmed and not t.still]
+        groups = owners(xy, np.array([t.position for t in walking]).reshape(-1, 2), self._half_stride_m)
         out = pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups,
                         np.array([o.width for o in objs]))
-        return self._stance_partners(out, detection, world, legs, leg_scores, xy, groups, people)
+        return self._stance_partners(out, detection, world, legs, leg_scores, xy, groups, walking)
 
     def _stance_partners(self, candidates: list[PersonCandidate], detection: Detection, world: Pose2D,
                          legs: LegCandidates, leg_scores: np.ndarray, xy: np.ndarray, groups: np.ndarray,
-                         people: np.ndarray) -> list[PersonCandidate]:
+                         walking: list[TrackState]) -> list[PersonCandidate]:
         """A walker's lone moving leg, paired with their standing leg.
 
         While one leg swings the other stands on the floor, still, and is no moving object:
         the swinging leg alone lies up to half a stride from the torso. A lone moving leg
         owned by a walking track (see :func:`owners`), with a still leg-shaped segment of
         this scan (leg probability at least ``start_leg_probability``) between two leg
-        radii and a stride from it, owned by no other walker, whose midpoint with the leg
+        radii and a stride from it, owned by nobody else (walking or standing: a standing
+        person's legs are theirs), whose midpoint with the leg
         lies nearer the track's prediction than the leg does, is that person's leg pair:
         the candidate moves to the midpoint, with a leg pair's uncertainty. Nothing else
         changes: a leg no walking track owns is left alone (furniture beside a passer-by
         starts nobody)."""
         lone = [k for k, c in enumerate(candidates) if c.kind == "leg"] if self.pairing.stance_partner else []
         keep = leg_scores >= self.assoc.start_leg_probability
-        if not lone or not keep.any() or not len(people):
+        if not lone or not keep.any() or not walking:
             return candidates
         moving = np.zeros(detection.labels.shape, dtype=bool)
         for o in detection.objects:
@@ -416,20 +417,22 @@ class PeopleTracker:
             return candidates
         widths = legs.features[still, 1]
         s_xy = world.transform_points(leg_centres(legs.xy[still], widths, self.pairing.max_leg_radius_m))
-        s_own = owners(s_xy, people, self._half_stride_m)
+        # a standing person's legs are theirs: the owner among everyone confirmed, walking or not
+        everyone = [t for t in self._tracks if t.confirmed]
+        s_own = owners(s_xy, np.array([t.position for t in everyone]).reshape(-1, 2), self._half_stride_m)
         index = {o.object_id: i for i, o in enumerate(detection.objects)}
         out = list(candidates)
         taken: set[int] = set()
         for k in lone:
             i = index[candidates[k].object_ids[0]]
-            g = groups[i]
-            if g < 0:
+            if groups[i] < 0:
                 continue
+            walker = walking[groups[i]]
             d = np.hypot(*(s_xy - xy[i]).T)
             ok = ((d >= 2.0 * self.pairing.max_leg_radius_m) & (d <= self.pairing.max_leg_separation_m)
-                  & ((s_own < 0) | (s_own == g)))
+                  & np.array([o < 0 or everyone[o] is walker for o in s_own], dtype=bool))
             mids = 0.5 * (s_xy + xy[i])
-            ok &= np.hypot(*(mids - people[g]).T) < np.hypot(*(xy[i] - people[g]))
+            ok &= np.hypot(*(mids - walker.position).T) < np.hypot(*(xy[i] - walker.position))
             ok[list(taken)] = False
             if not ok.any():
                 continue

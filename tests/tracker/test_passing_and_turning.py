@@ -276,10 +276,11 @@ def test_a_new_track_gives_way_to_a_confirmed_one_when_in_doubt():
     assert tracker._associate([PersonCandidate(2.5, 0.0, 0.08, "leg")]) == [(0, 0)]
 
 
-def _lone_leg_case(prediction, owner=0, partner_score=0.9):
+def _lone_leg_case(prediction, owner=0, partner_score=0.9, standing=None):
     """A scan with a walker's two legs (pillars at (3, 0) and (3, -0.4)); the one at y = 0
     is their lone moving leg, the other stands still; the walker's track is predicted at
-    ``prediction`` and owns the moving leg when ``owner`` is 0."""
+    ``prediction`` and owns the moving leg when ``owner`` is 0; ``standing``: where someone
+    else's confirmed track stands still."""
     from types import SimpleNamespace
 
     from people_tracker.detection.detector import Detection
@@ -292,8 +293,11 @@ def _lone_leg_case(prediction, owner=0, partner_score=0.9):
     detection = Detection(np.zeros(scan.n_beams, dtype=np.int8), [moving], ())
     lone = PersonCandidate(3.05, 0.0, 0.2, "leg", (7,))
     tracker = PeopleTracker.from_config(load_config())
+    walker = SimpleNamespace(position=np.array(prediction, dtype=float), confirmed=True, still=False)
+    tracker._tracks = [walker] + ([SimpleNamespace(position=np.array(standing, dtype=float), confirmed=True, still=True)]
+                                  if standing is not None else [])
     return tracker._stance_partners([lone], detection, Pose2D(), legs, np.full(len(legs), partner_score),
-                                    np.array([[3.05, 0.0]]), np.array([owner]), np.array([prediction], dtype=float))[0]
+                                    np.array([[3.05, 0.0]]), np.array([owner]), [walker])[0]
 
 
 def test_a_walkers_lone_moving_leg_pairs_with_their_standing_leg():
@@ -307,6 +311,9 @@ def test_a_lone_moving_leg_keeps_its_place_when_the_partner_leads_away_from_the_
     assert _lone_leg_case([3.05, 0.3]).kind == "leg"  # the still leg lies on the far side of the prediction
     assert _lone_leg_case([3.05, -0.2], owner=-1).kind == "leg"  # nobody's leg: nothing is paired
     assert _lone_leg_case([3.05, -0.2], partner_score=0.1).kind == "leg"  # the still thing is no leg
+    # someone standing there: the still leg is theirs (traced in the waiting room: a walker
+    # stopping face to face with someone took their leg, slid onto them and was deleted)
+    assert _lone_leg_case([3.05, -0.2], standing=[3.1, -0.5]).kind == "leg"
 
 
 def test_stance_partners_bring_a_walkers_lone_legs_nearer_the_torso():
