@@ -180,13 +180,17 @@ def _sides(scan: Scan, mean: np.ndarray, rng: np.ndarray, width: np.ndarray) -> 
     across = (0.5 * width[:, None] + offsets[None, :]) / np.maximum(rng, 0.05)[:, None]  # (k, m) radians
     bearing = np.arctan2(mean[:, 1], mean[:, 0])[:, None]
     beam = scan.beam_of(np.concatenate([bearing - across, bearing + across], axis=1))  # (k, 2m)
-    # the reading there, or the nearest real one within two beams of it (lost readings)
+    # the reading there, or the nearest real one within two beams of it (lost readings);
+    # two real ones equally near, one either side: the nearer range, whichever way the
+    # laser sweeps (taking the one before in beam order made a clockwise laser differ)
     shifts = np.array([0, -1, 1, -2, 2])
     cand = np.minimum(np.maximum(beam[:, :, None] + shifts, 0), scan.n_beams - 1)  # (k, 2m, 5)
     real = scan.valid[cand] & (beam[:, :, None] >= 0)
-    flat = cand.reshape(-1, len(shifts))
-    pick = flat[np.arange(len(flat)), np.argmax(real, axis=2).ravel()].reshape(beam.shape)
-    value = np.minimum(np.maximum(scan.ranges[pick] - rng[:, None], -1.0), NO_RETURN_M)
+    ranges = np.where(real, scan.ranges[cand], np.inf)
+    level = np.array([0, 1, 1, 2, 2])  # beams away from the place looked at
+    first = np.min(np.where(real, level, 3), axis=2)  # the nearest level with a real reading
+    nearest = np.min(np.where(level == first[:, :, None], ranges, np.inf), axis=2)
+    value = np.minimum(np.maximum(nearest - rng[:, None], -1.0), NO_RETURN_M)
     value = np.where(real.any(axis=2), value, NO_RETURN_M)
     m = len(offsets)
     lo, hi = np.minimum(value[:, :m], value[:, m:]), np.maximum(value[:, :m], value[:, m:])

@@ -423,6 +423,11 @@ class PeopleTracker:
         index = {o.object_id: i for i, o in enumerate(detection.objects)}
         out = list(candidates)
         taken: set[int] = set()
+        # lone legs take partners counter-clockwise (by bearing, not by beam order), so that
+        # a clockwise laser pairs the same legs as a counter-clockwise one
+        objs = detection.objects
+        lone.sort(key=lambda k: math.atan2(objs[index[candidates[k].object_ids[0]]].y,
+                                           objs[index[candidates[k].object_ids[0]]].x))
         for k in lone:
             i = index[candidates[k].object_ids[0]]
             if groups[i] < 0:

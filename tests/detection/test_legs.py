@@ -45,6 +45,25 @@ def test_features_do_not_depend_on_the_beam_order():
     np.testing.assert_allclose(a.features[order_a], b.features[order_b], atol=1e-9)
 
 
+def test_features_with_lost_readings_do_not_depend_on_the_beam_order():
+    """Where the reading beside a candidate is lost and both its neighbours are real, the
+    nearer is taken, whichever way the laser sweeps (a clockwise laser took the other one
+    and scored a leg 0.31 that a counter-clockwise one scored 0.80)."""
+    import dataclasses
+
+    scan = _scan()
+    ranges = scan.ranges.copy()
+    ranges[1::3] = np.nan  # every third reading lost
+    ccw = dataclasses.replace(scan, ranges=ranges)
+    cw = dataclasses.replace(scan, ranges=ranges[::-1].copy(), angle_increment=-scan.angle_increment,
+                             angle_min=scan.angle_min + (scan.n_beams - 1) * scan.angle_increment)
+    a, b = leg_candidates(ccw), leg_candidates(cw)
+    order_a, order_b = np.lexsort(a.xy.T), np.lexsort(b.xy.T)
+    assert len(a) >= 2
+    np.testing.assert_allclose(a.xy[order_a], b.xy[order_b], atol=1e-9)
+    np.testing.assert_allclose(a.features[order_a], b.features[order_b], atol=1e-9)
+
+
 @pytest.mark.parametrize("resolution_deg", [0.25, 0.5, 1.0])
 def test_a_leg_is_found_at_other_resolutions(resolution_deg):
     c = leg_candidates(_scan(resolution_deg=resolution_deg))
