@@ -425,9 +425,8 @@ class PeopleTracker:
         taken: set[int] = set()
         # lone legs take partners counter-clockwise (by bearing, not by beam order), so that
         # a clockwise laser pairs the same legs as a counter-clockwise one
-        objs = detection.objects
-        lone.sort(key=lambda k: math.atan2(objs[index[candidates[k].object_ids[0]]].y,
-                                           objs[index[candidates[k].object_ids[0]]].x))
+        seen = world.inverse().transform_points(xy)  # the legs in the sensor frame
+        lone.sort(key=lambda k: math.atan2(*seen[index[candidates[k].object_ids[0]]][::-1]))
         for k in lone:
             i = index[candidates[k].object_ids[0]]
             if groups[i] < 0:
