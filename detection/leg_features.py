@@ -74,6 +74,12 @@ class LegCandidates:
     def __len__(self) -> int:
         return len(self.xy)
 
+    def touching(self, mask: np.ndarray) -> np.ndarray:
+        """Which candidates span a beam where ``mask`` (bool, one per beam of the scan) is set."""
+        # c[i] counts the set beams before beam i
+        c = np.concatenate([[0], np.cumsum(mask)])
+        return c[self.last_beam + 1] > c[self.first_beam]
+
 
 def _empty() -> LegCandidates:
     z = np.zeros(0, dtype=np.int64)
@@ -190,8 +196,7 @@ def _sides(scan: Scan, mean: np.ndarray, rng: np.ndarray, width: np.ndarray) -> 
     level = np.array([0, 1, 1, 2, 2])  # beams away from the place looked at
     first = np.min(np.where(real, level, 3), axis=2)  # the nearest level with a real reading
     nearest = np.min(np.where(level == first[:, :, None], ranges, np.inf), axis=2)
-    value = np.minimum(np.maximum(nearest - rng[:, None], -1.0), NO_RETURN_M)
-    value = np.where(real.any(axis=2), value, NO_RETURN_M)
+    value = np.minimum(np.maximum(nearest - rng[:, None], -1.0), NO_RETURN_M)  # none real: inf, so NO_RETURN_M
     m = len(offsets)
     lo, hi = np.minimum(value[:, :m], value[:, m:]), np.maximum(value[:, :m], value[:, m:])
     return np.column_stack([lo, hi]).reshape(len(mean), 2, m).transpose(0, 2, 1).reshape(len(mean), 2 * m)

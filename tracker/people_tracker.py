@@ -412,7 +412,7 @@ class PeopleTracker:
         moving = np.zeros(detection.labels.shape, dtype=bool)
         for o in detection.objects:
             moving[o.beams] = True
-        still = keep & np.array([not moving[a:b + 1].any() for a, b in zip(legs.first_beam, legs.last_beam)])
+        still = keep & ~legs.touching(moving)
         if not still.any():
             return candidates
         widths = legs.features[still, 1]
@@ -566,8 +566,7 @@ class PeopleTracker:
             return []
         keep = scores >= p.min_leg_probability
         if self._explained is not None and keep.any():  # a passer-by's leg pairs with nobody standing
-            taken = np.concatenate([[0], np.cumsum(self._explained[scan.valid])])
-            keep &= taken[legs.stop] == taken[legs.start]
+            keep &= ~legs.touching(self._explained)
         xy = legs.xy[keep]
         if self.pairing.max_leg_radius_m > 0 and len(xy):
             pts = scan.valid_points
