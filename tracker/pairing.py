@@ -157,8 +157,25 @@ def nearest_pairs(xy: np.ndarray, min_separation_m: float, max_separation_m: flo
     return out
 
 
+def _stays_with_owner(xy: np.ndarray, g: np.ndarray, predictions: np.ndarray, half_stride_m: float) -> np.ndarray:
+    """(k, k) mask: False where an owned leg (``g`` >= 0) and an unowned one would pair
+    into a midpoint farther than half a stride from the owner's prediction and farther
+    from it than the owned leg (see :func:`pair_legs`)."""
+    owned = g >= 0
+    mixed = owned[:, None] != owned[None, :]
+    if not mixed.any():
+        return np.ones(mixed.shape, dtype=bool)
+    own = np.where(owned[:, None], np.arange(len(g))[:, None], np.arange(len(g))[None, :])  # the owned one of each pair
+    centre = predictions[np.maximum(g[own], 0)]  # (k, k, 2)
+    mid = 0.5 * (xy[:, None, :] + xy[None, :, :])
+    d_mid = np.hypot(*np.moveaxis(mid - centre, -1, 0))
+    d_own = np.hypot(*np.moveaxis(xy[own] - centre, -1, 0))
+    return ~mixed | (d_mid <= half_stride_m) | (d_mid < d_own)
+
+
 def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: PairingParams,
-              groups: np.ndarray | None = None, depths: np.ndarray | None = None) -> list[PersonCandidate]:
+              groups: np.ndarray | None = None, depths: np.ndarray | None = None,
+              predictions: np.ndarray | None = None) -> list[PersonCandidate]:
     """Person candidates from moving objects.
 
     Parameters
@@ -175,6 +192,13 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
     depths : ndarray, shape (k,), optional
         Shortest side of each object's bounding rectangle, metres: flat objects (see
         :class:`PairingParams`) are neither legs nor people.
+    predictions : ndarray, shape (p, 2), optional
+        The owners' predicted torso positions (same frame as ``xy``, m; ``groups`` index
+        them). A leg one person owns pairs with a leg nobody owns only when the pair stays
+        that person's: its midpoint lies within half a stride of their prediction, or
+        nearer it than their own leg does. A pair that pulls their leg away from them is
+        their leg and somebody else's (a passer-by's leg with the one of a person they
+        half hide), a torso where nobody is.
     """
     round_ = np.ones(len(sizes), dtype=bool)
     if depths is not None and params.flat_max_depth_m > 0:
@@ -186,6 +210,8 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
     if groups is not None:  # never two legs that belong to two different people
         g = groups[legs]
         allowed = (g[:, None] == g[None, :]) | (g[:, None] < 0) | (g[None, :] < 0)
+        if predictions is not None and len(predictions):
+            allowed &= _stays_with_owner(xy[legs], g, predictions, 0.5 * params.max_leg_separation_m)
     paired = set()
     for a, b in nearest_pairs(xy[legs], 0.0, params.max_leg_separation_m, allowed):
         i, j = int(legs[a]), int(legs[b])

@@ -385,9 +385,10 @@ class PeopleTracker:
         # legs near a tracked walking person are that person's: never paired with another
         # person's. A person standing still owns no moving legs: those are a passer-by's.
         walking = [t for t in self._tracks if t.confirmed and not t.still]
-        groups = owners(xy, np.array([t.position for t in walking]).reshape(-1, 2), self._half_stride_m)
+        predicted = np.array([t.position for t in walking]).reshape(-1, 2)
+        groups = owners(xy, predicted, self._half_stride_m)
         out = pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups,
-                        np.array([o.width for o in objs]))
+                        np.array([o.width for o in objs]), predicted)
         return self._stance_partners(out, detection, world, legs, leg_scores, xy, groups, walking)
 
     def _stance_partners(self, candidates: list[PersonCandidate], detection: Detection, world: Pose2D,

@@ -466,3 +466,29 @@ def test_someone_who_sets_off_hands_their_id_to_their_walking_track_after_the_tr
     assert tracker._set_off(stander, 0.93)
     stander.last_update = 0.86  # updated after the walker was confirmed: still standing there
     assert not tracker._set_off(stander, 0.93)
+
+
+def test_a_walkers_leg_never_pairs_away_from_them_with_a_leg_nobody_owns():
+    p = PairingParams()  # a stride 0.8 m: half a stride 0.4 m
+    from people_tracker.tracker.pairing import owners
+    walker = np.array([[2.0, 0.0]])  # a walker's prediction; their leg at 0.3 m is theirs
+    sizes = np.full(2, 0.12)
+    # a passer-by's leg 0.5 m beyond it: the pair's midpoint is 0.55 m from the walker and
+    # farther than their own leg; refused, both stay lone legs
+    xy = np.array([[2.3, 0.0], [2.8, 0.0]])
+    groups = owners(xy, walker, 0.4)
+    assert groups.tolist() == [0, -1]
+    kinds = [c.kind for c in pair_legs(xy, sizes, [1, 2], p, groups, predictions=walker)]
+    assert kinds == ["leg", "leg"]
+    assert [c.kind for c in pair_legs(xy, sizes, [1, 2], p, groups)] == ["pair"]  # without the predictions
+    # their other leg, even one the owner test left unowned, brings the pair to them
+    xy = np.array([[2.3, 0.0], [1.55, 0.0]])
+    groups = owners(xy, walker, 0.4)
+    assert groups.tolist() == [0, -1]
+    assert [c.kind for c in pair_legs(xy, sizes, [1, 2], p, groups, predictions=walker)] == ["pair"]
+    # a pair whose midpoint lies within half a stride of them is theirs, though farther
+    # from them than their own leg
+    xy = np.array([[2.1, 0.0], [2.1, 0.6]])
+    groups = owners(xy, walker, 0.4)
+    assert groups.tolist() == [0, -1]
+    assert [c.kind for c in pair_legs(xy, sizes, [1, 2], p, groups, predictions=walker)] == ["pair"]
