@@ -54,7 +54,6 @@ class SceneRun:
     seed: int | None
     stamps: np.ndarray  # (n,) s
     rows: np.ndarray  # (m, 5): scan index, track id, x, y (sensor frame, m), confidence
-    world_rows: np.ndarray  # (m, 2): x, y in the world frame, m
     truths: list  # the simulator's Truth per scan
 
 
@@ -62,15 +61,13 @@ def run_scene(name: str, seed: int | None, duration: float | None, people: int |
               config=None) -> SceneRun:
     source = SimulatedSource(name, seed=seed, duration=duration, people=people)
     tracker = PeopleTracker.from_config(config if config is not None else load_config())
-    rows, world, stamps = [], [], []
+    rows, stamps = [], []
     for record in source.scans():
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
         stamps.append(record.scan.stamp)
         for t, (x, y) in zip(tracks, tracks_in_sensor_frame(tracks, tracker.last.pose)):
             rows.append((record.index, t.track_id, x, y, t.confidence))
-            world.append((t.x, t.y))
-    return SceneRun(name, seed, np.array(stamps), np.array(rows, dtype=float).reshape(-1, 5),
-                    np.array(world, dtype=float).reshape(-1, 2), source.truths)
+    return SceneRun(name, seed, np.array(stamps), np.array(rows, dtype=float).reshape(-1, 5), source.truths)
 
 
 def _scans_with_people(run: SceneRun):
@@ -82,11 +79,13 @@ def _scans_with_people(run: SceneRun):
 
 
 def nearest_person(run: SceneRun) -> tuple[np.ndarray, np.ndarray]:
-    """For each reported row: the distance to the nearest person in the scene (m) and their id."""
+    """For each reported row: the distance to the nearest person in the scene (m) and their id.
+    In the sensor frame, as ``evaluate`` scores: the tracker's world frame may drift from the
+    simulator's (scan matching), which says nothing of where the tracks are."""
     dist = np.full(len(run.rows), np.inf)
     who = np.full(len(run.rows), -1, dtype=np.int64)
     for sel, tr in _scans_with_people(run):
-        d = pairwise_distances(run.world_rows[sel], tr.torso_world)
+        d = pairwise_distances(run.rows[sel, 2:4], tr.torso_sensor)
         j = d.argmin(axis=1)
         dist[sel] = d[np.arange(len(sel)), j]
         who[sel] = tr.person_id[j]
@@ -100,7 +99,7 @@ def ids_per_person(run: SceneRun) -> dict[int, set[int]]:
     passing close by is not an id of theirs."""
     ids: dict[int, set[int]] = {}
     for sel, tr in _scans_with_people(run):
-        for i, j in associate(pairwise_distances(tr.torso_world, run.world_rows[sel]), NEAR_M, "gnn"):
+        for i, j in associate(pairwise_distances(tr.torso_sensor, run.rows[sel, 2:4]), NEAR_M, "gnn"):
             ids.setdefault(int(tr.person_id[i]), set()).add(int(run.rows[sel[j], 1]))
     return ids
 

@@ -32,7 +32,7 @@ from track_evidence import NEAR_M, SceneRun, nearest_person  # noqa: E402
 
 from people_tracker.tracker.config import load_config  # noqa: E402
 from people_tracker.tracker.io.simulated import SimulatedSource  # noqa: E402
-from people_tracker.tracker.people_tracker import PeopleTracker  # noqa: E402
+from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame  # noqa: E402
 
 LASTING_S = 1.0  # a hop after which the track stays this long on the new person is no flicker
 
@@ -68,14 +68,13 @@ def _run(scene: str, seed: int | None, duration: float | None):
     """``track_evidence.run_scene`` with the noting tracker."""
     source = SimulatedSource(scene, seed=seed, duration=duration)
     tracker = _NotingTracker.from_config(load_config())
-    rows, world, stamps = [], [], []
+    rows, stamps = [], []
     for record in source.scans():
-        for t in tracker.step(record.scan, record.pose, record.pose_last_beam):
-            rows.append((record.index, t.track_id, 0.0, 0.0, t.confidence))
-            world.append((t.x, t.y))
+        tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
+        for t, (x, y) in zip(tracks, tracks_in_sensor_frame(tracks, tracker.last.pose)):
+            rows.append((record.index, t.track_id, x, y, t.confidence))
         stamps.append(record.scan.stamp)
-    run = SceneRun(scene, seed, np.array(stamps), np.array(rows, dtype=float).reshape(-1, 5),
-                   np.array(world, dtype=float).reshape(-1, 2), source.truths)
+    run = SceneRun(scene, seed, np.array(stamps), np.array(rows, dtype=float).reshape(-1, 5), source.truths)
     return run, tracker.how
 
 
