@@ -63,6 +63,12 @@ class PairingParams:
     flat_max_depth_m: float = 0.015
     stance_partner: bool = True
 
+    @property
+    def half_stride_m(self) -> float:
+        """Half of ``max_leg_separation_m``: farthest a leg lies from its person's torso, and
+        where a stepping leg lands from where they stood, m."""
+        return 0.5 * self.max_leg_separation_m
+
 
 @dataclass(frozen=True, eq=False)
 class PersonCandidate:
@@ -211,7 +217,7 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
         g = groups[legs]
         allowed = (g[:, None] == g[None, :]) | (g[:, None] < 0) | (g[None, :] < 0)
         if predictions is not None and len(predictions):
-            allowed &= _stays_with_owner(xy[legs], g, predictions, 0.5 * params.max_leg_separation_m)
+            allowed &= _stays_with_owner(xy[legs], g, predictions, params.half_stride_m)
     paired = set()
     for a, b in nearest_pairs(xy[legs], 0.0, params.max_leg_separation_m, allowed):
         i, j = int(legs[a]), int(legs[b])

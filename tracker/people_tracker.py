@@ -666,9 +666,8 @@ class PeopleTracker:
 
     @property
     def _half_stride_m(self) -> float:
-        """Half of ``pairing.max_leg_separation_m``: farthest a leg lies from its person's
-        torso, and where a stepping leg lands from where they stood, m."""
-        return 0.5 * self.pairing.max_leg_separation_m
+        """``pairing.half_stride_m``, m."""
+        return self.pairing.half_stride_m
 
     def _duplicates(self) -> set[int]:
         """Indices of tracks that slid onto a person standing still who has a track already.
