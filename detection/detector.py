@@ -12,12 +12,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from people_tracker.detection import compiled
 from people_tracker.detection.closest import closest_point_static
 from people_tracker.detection.kdtree import PointTree
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
 from people_tracker.detection.objects import MovingObject, describe_all
 from people_tracker.detection.recover import isolated_occluded, recover_moving
-from people_tracker.detection.scan_lines import bin_to_beams, scan_line_labels
+from people_tracker.detection.scan_lines import bin_to_beams, line_labels_kernel, scan_line_labels
 from people_tracker.detection.segments import split_runs
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models.pose import Pose2D, pairwise_distances
@@ -145,14 +146,21 @@ def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
     labels[valid_c[static_c]] = STATIC
     # 2. Algorithm 1 on B_C, B_P: the previous readings binned to the current beams
     b_c = valid_c[~static_c]
-    beam_all = bin_to_beams(pts_p, scan.angle_min, scan.angle_increment, scan.n_beams)
     # lines of sight the previous scan saw through (no return): free up to no_return_free_m
-    beam_seen, r_seen = beam_all, r_p
     far = np.flatnonzero(prev.no_return) if params.no_return_free_m > 0 else ()
+    pts_far = None
     if len(far):
         a = prev.angles[far]
         reach = min(prev.range_max, params.no_return_free_m)
         pts_far = rel.transform_points(reach * np.column_stack([np.cos(a), np.sin(a)]))
+    if compiled.on:  # the binning and Algorithm 1 below as one compiled loop
+        labels[b_c] = line_labels_kernel(b_c, scan.ranges[b_c], pts_p, r_p, static_p,
+                                         pts_far if pts_far is not None else np.zeros((0, 2)), scan.angle_min,
+                                         scan.angle_increment, scan.n_beams, params.scan_line_window)
+        return labels
+    beam_all = bin_to_beams(pts_p, scan.angle_min, scan.angle_increment, scan.n_beams)
+    beam_seen, r_seen = beam_all, r_p
+    if pts_far is not None:
         beam_seen = np.concatenate([beam_all, bin_to_beams(pts_far, scan.angle_min, scan.angle_increment, scan.n_beams)])
         r_seen = np.concatenate([r_p, np.hypot(pts_far[:, 0], pts_far[:, 1])])
     label_c, _ = scan_line_labels(b_c, scan.ranges[b_c], beam_all[~static_p], r_p[~static_p], scan.n_beams,

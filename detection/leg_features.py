@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from people_tracker.detection import compiled
+from people_tracker.detection.compiled import add_reduce, beam_of, njit
 from people_tracker.models.scan import Scan
 
 FEATURES = (
@@ -47,6 +49,10 @@ SIDE_OFFSETS_M = (0.1, 0.2, 0.3, 0.5)
 # annotated hallway recording inf), so the features do not tell them apart: a model that
 # did learned one driver's convention and failed on the other.
 NO_RETURN_M = 3.0
+# how far beside a candidate's end the jump and gap features look: this far across at the
+# end's range, at most this many beams
+BESIDE_M = 0.3
+BESIDE_MAX_BEAMS = 12
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,6 +113,15 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     pts = scan.valid_points
     r = scan.ranges[beams]
     res = scan.resolution
+    if compiled.on:  # the same arithmetic compiled (see detection/compiled.py)
+        valid_start, n, mean, shape, end = _shape_kernel(pts, r, res, gap_m, gap_beams, min_points, max_width_m)
+        if not len(n):
+            return _empty()
+        first, last = beams[valid_start], beams[valid_start + n - 1]
+        features = _context_kernel(shape, mean, np.concatenate([first, last]), pts[end], r[end], scan.valid,
+                                   scan.ranges, scan.points, scan.angle_min, scan.angle_increment, np.array(SIDE_OFFSETS_M),
+                                   NO_RETURN_M, BESIDE_M, BESIDE_MAX_BEAMS)
+        return LegCandidates(first, last, valid_start, valid_start + n, mean, features)
     d = pts[1:] - pts[:-1]
     step = np.hypot(d[:, 0], d[:, 1])
     limit = np.maximum(gap_m, gap_beams * res * np.maximum(r[:-1], r[1:]))
@@ -203,7 +218,7 @@ def _sides(scan: Scan, mean: np.ndarray, rng: np.ndarray, width: np.ndarray) -> 
 
 
 def _beside(scan: Scan, beam: np.ndarray, side: np.ndarray, end_xy: np.ndarray, end_r: np.ndarray,
-            lateral_m: float = 0.3, max_beams: int = 12) -> tuple[np.ndarray, np.ndarray]:
+            lateral_m: float = BESIDE_M, max_beams: int = BESIDE_MAX_BEAMS) -> tuple[np.ndarray, np.ndarray]:
     """Range step and distance from each candidate end to the first reading beside it on
     its ``side`` (per end: -1 before, +1 after in beam order), looking as far as ``lateral_m`` across at
     the end's range (``max_beams`` at most): a valid reading gives its range minus the
@@ -223,3 +238,136 @@ def _beside(scan: Scan, beam: np.ndarray, side: np.ndarray, end_xy: np.ndarray, 
     d = scan.points[first] - end_xy
     gap = np.where(found, np.hypot(d[:, 0], d[:, 1]), NO_RETURN_M)
     return jump, np.minimum(gap, NO_RETURN_M)
+
+
+def _shape_loop(pts, r, res, gap_m, gap_beams, min_points, max_width_m):
+    """:func:`leg_candidates`' runs and their first 11 features as one loop (compiled by
+    numba; the numpy code above is the reference and does the same arithmetic in the same
+    order, sums included). Returns the kept runs' first reading (index into the valid
+    readings), reading count, mean (k, 2), features ``n_rel`` .. ``centre_depth_m`` (k, 11)
+    and the indices of their first readings and then their last ones (2k,)."""
+    m = len(pts)
+    bounds = np.empty(m + 1, np.int64)
+    bounds[0] = 0
+    nb = 1
+    step = np.zeros(m)
+    for i in range(m - 1):
+        step[i] = np.hypot(pts[i + 1, 0] - pts[i, 0], pts[i + 1, 1] - pts[i, 1])
+        if step[i] >= max(gap_m, gap_beams * res * max(r[i], r[i + 1])):
+            bounds[nb] = i + 1
+            nb += 1
+    bounds[nb] = m
+    nb += 1
+    keep = np.empty(nb - 1, np.int64)
+    k = 0
+    for j in range(nb - 1):
+        a, b = bounds[j], bounds[j + 1]
+        w = np.hypot(pts[b - 1, 0] - pts[a, 0], pts[b - 1, 1] - pts[a, 1])
+        if b - a >= min_points and w <= max_width_m:
+            keep[k] = j
+            k += 1
+    start = np.empty(k, np.int64)
+    count = np.empty(k, np.int64)
+    mean = np.empty((k, 2))
+    out = np.empty((k, 11))
+    ends = np.empty(2 * k, np.int64)
+    for c in range(k):
+        a, b = bounds[keep[c]], bounds[keep[c] + 1]
+        n = b - a
+        start[c], count[c] = a, n
+        ends[c], ends[k + c] = a, b - 1
+        cx, cy = pts[b - 1, 0] - pts[a, 0], pts[b - 1, 1] - pts[a, 1]
+        width = np.hypot(cx, cy)
+        mx, my = add_reduce(pts[a:b, 0]) / n, add_reduce(pts[a:b, 1]) / n
+        t = np.empty((7, n))  # per reading: u², v², uv, uq, vq, then the circle and the chord terms
+        for i in range(n):
+            u, v = pts[a + i, 0] - mx, pts[a + i, 1] - my
+            q = u ** 2 + v ** 2
+            t[0, i], t[1, i], t[2, i], t[3, i], t[4, i] = u ** 2, v ** 2, u * v, u * q, v * q
+        suu, svv, suv, suq, svq = add_reduce(t[0]), add_reduce(t[1]), add_reduce(t[2]), add_reduce(t[3]), add_reduce(t[4])
+        det = suu * svv - suv ** 2
+        ca = 0.5 * (svv * suq - suv * svq) / det
+        cb = 0.5 * (suu * svq - suv * suq) / det
+        radius = np.sqrt(ca ** 2 + cb ** 2 + (suu + svv) / n)
+        straight = not np.isfinite(radius) or radius > 1.0 or n < 3
+        if straight:
+            radius, ca, cb = 1.0, 0.0, 0.0
+        wn = max(width, 1e-9)
+        nx, ny = -cy / wn, cx / wn
+        towards = 1.0 if -pts[a, 0] * nx + -pts[a, 1] * ny >= 0.0 else -1.0
+        for i in range(n):
+            t[0, i] = (np.hypot(pts[a + i, 0] - mx - ca, pts[a + i, 1] - my - cb) - radius) ** 2
+            t[1, i] = step[a + i] if i < n - 1 else 0.0
+            # einsum's dot product: from +0.0, so a reading on the chord gives +0.0 whatever the signs
+            t[2, i] = (0.0 + (pts[a + i, 0] - pts[a, 0]) * nx + (pts[a + i, 1] - pts[a, 1]) * ny) * towards
+        boundary = add_reduce(t[1])
+        tr = suu + svv
+        lam_min = max(0.5 * tr - np.sqrt(max(0.25 * tr ** 2 - det, 0.0)), 0.0)
+        rng = np.hypot(mx, my)
+        mean[c, 0], mean[c, 1] = mx, my
+        out[c, 0] = n / (width / max(rng * res, 1e-6) + 1.0)
+        out[c, 1] = width
+        out[c, 2] = rng
+        out[c, 3] = np.sqrt(tr / n)
+        out[c, 4] = radius
+        out[c, 5] = 0.0 if straight else np.sqrt(add_reduce(t[0]) / n)
+        out[c, 6] = np.sqrt(lam_min / n)
+        out[c, 7] = boundary
+        out[c, 8] = boundary / max(width, 1e-3)
+        out[c, 9] = add_reduce(t[2]) / n
+        out[c, 10] = 0.0 if straight else np.hypot(mx + ca, my + cb) - rng
+    return start, count, mean, out, ends
+
+
+def _context_loop(shape, mean, end_beam, end_xy, end_r, valid, ranges, points, angle_min, angle_increment, offsets,
+                  no_return, lateral_m, max_beams):
+    """The features of what lies beside each candidate (:func:`_beside` at both ends,
+    then :func:`_sides`) after its own shape (k, 11): the whole feature table, compiled.
+    ``end_beam``, ``end_xy``, ``end_r``: every candidate's first reading, then every last."""
+    k, n_beams = len(shape), len(valid)
+    res = abs(angle_increment)
+    m = len(offsets)
+    out = np.empty((k, 14 + 2 * m))
+    out[:, :11] = shape
+    jump = np.full(2 * k, no_return)
+    gap = np.full(2 * k, no_return)
+    for e in range(2 * k):  # _beside
+        side = -1 if e < k else 1
+        reach = min(max(np.ceil(lateral_m / max(end_r[e] * res, 1e-6)), 1.0), float(max_beams))
+        for s in range(1, max_beams + 1):
+            j = end_beam[e] + side * s
+            if s > reach or j < 0 or j >= n_beams:
+                break
+            if valid[j]:
+                jump[e] = min(max(ranges[j] - end_r[e], -1.0), no_return)
+                gap[e] = min(np.hypot(points[j, 0] - end_xy[e, 0], points[j, 1] - end_xy[e, 1]), no_return)
+                break
+    shifts = (0, -1, 1, -2, 2)
+    levels = (0, 1, 1, 2, 2)
+    for c in range(k):
+        out[c, 11] = min(jump[c], jump[k + c])
+        out[c, 12] = max(jump[c], jump[k + c])
+        out[c, 13] = min(gap[c], gap[k + c])
+        rng, width = shape[c, 2], shape[c, 1]
+        bearing = np.arctan2(mean[c, 1], mean[c, 0])
+        for o in range(m):
+            across = (0.5 * width + offsets[o]) / max(rng, 0.05)
+            value = np.empty(2)
+            for h in range(2):
+                beam = beam_of(bearing - across if h == 0 else bearing + across, angle_min, angle_increment, n_beams)
+                first, nearest = 3, np.inf
+                for t in range(5):
+                    i = min(max(beam + shifts[t], 0), n_beams - 1)
+                    if beam >= 0 and valid[i]:
+                        if levels[t] < first:
+                            first, nearest = levels[t], ranges[i]
+                        elif levels[t] == first:
+                            nearest = min(nearest, ranges[i])
+                value[h] = min(max(nearest - rng, -1.0), no_return)
+            out[c, 14 + 2 * o] = min(value[0], value[1])
+            out[c, 15 + 2 * o] = max(value[0], value[1])
+    return out
+
+
+_shape_kernel = njit(_shape_loop)
+_context_kernel = njit(_context_loop)

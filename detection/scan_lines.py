@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW
+from people_tracker.detection.compiled import beam_of, njit
 from people_tracker.models.scan import beam_index
 
 
@@ -111,3 +112,67 @@ def scan_line_labels(beam_c: np.ndarray, range_c: np.ndarray, beam_p: np.ndarray
     label_p[partner[nearer]] = OCCLUDED
     label_p[partner[farther]] = MOVING
     return label_c, label_p
+
+
+def _nearest_per_beam_loop(beam, rng, use, n_beams):
+    """:func:`_nearest_per_beam` of the readings ``use`` marks: per beam the nearest, and of
+    equally near ones the last (as the stable sort and its last write there)."""
+    at_beam = np.full(n_beams, -1, np.int64)
+    for i in range(len(beam)):
+        b = beam[i]
+        if use[i] and b >= 0:
+            j = at_beam[b]
+            if j < 0 or rng[i] < rng[j] or (rng[i] == rng[j] and i > j):
+                at_beam[b] = i
+    return at_beam
+
+
+def _partner_of(b, at_beam, rng, window):
+    """:func:`_partner` for the one current beam ``b``."""
+    n_beams = len(at_beam)
+    partner = at_beam[b]
+    step = 1
+    while partner < 0 and step <= window:
+        lo = at_beam[max(b - step, 0)]
+        hi = at_beam[min(b + step, n_beams - 1)]
+        r_lo = rng[lo] if lo >= 0 else np.inf
+        r_hi = rng[hi] if hi >= 0 else np.inf
+        partner = hi if r_hi < r_lo else lo
+        step += 1
+    return partner
+
+
+def _line_labels_loop(beam_c, range_c, pts_p, range_p, static_p, pts_far, angle_min, angle_increment, n_beams,
+                      window):
+    """The current readings' labels of :func:`scan_line_labels` as the detector asks for them
+    (B_P: the previous readings ``pts_p``, current frame, not ``static_p``; the fall-back:
+    all of them and the free points ``pts_far``), the binning (:func:`bin_to_beams`)
+    included; compiled by numba, the numpy functions above are the reference."""
+    m, f = len(pts_p), len(pts_far)
+    beam_all = np.empty(m + f, np.int64)
+    range_all = np.empty(m + f)
+    for i in range(m):
+        beam_all[i] = beam_of(np.arctan2(pts_p[i, 1], pts_p[i, 0]), angle_min, angle_increment, n_beams)
+        range_all[i] = range_p[i]
+    for i in range(f):
+        beam_all[m + i] = beam_of(np.arctan2(pts_far[i, 1], pts_far[i, 0]), angle_min, angle_increment, n_beams)
+        range_all[m + i] = np.hypot(pts_far[i, 0], pts_far[i, 1])
+    moving_p = np.zeros(m + f, np.bool_)
+    moving_p[:m] = ~static_p
+    at_p = _nearest_per_beam_loop(beam_all, range_all, moving_p, n_beams)
+    at_all = _nearest_per_beam_loop(beam_all, range_all, np.ones(m + f, np.bool_), n_beams)
+    label = np.full(len(beam_c), OUT_OF_VIEW, np.int8)
+    for i in range(len(beam_c)):
+        p = _partner_of(beam_c[i], at_p, range_all, window)
+        if p < 0:
+            p = _partner_of(beam_c[i], at_all, range_all, window)
+            if p >= 0:
+                label[i] = MOVING if range_c[i] < range_all[p] else OCCLUDED
+        else:
+            label[i] = MOVING if range_c[i] < range_all[p] else OCCLUDED  # equal ranges: not evidence of motion
+    return label
+
+
+_nearest_per_beam_loop = njit(_nearest_per_beam_loop) or _nearest_per_beam_loop
+_partner_of = njit(_partner_of) or _partner_of
+line_labels_kernel = njit(_line_labels_loop)

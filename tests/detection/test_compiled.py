@@ -1,0 +1,143 @@
+"""The compiled kernels (numba, the [fast] extra) give what their numpy twins give, to the bit.
+
+Each kernel stands in for numpy code that stays the reference; here both run on the same
+scans (simulated lasers of every kind the pipeline meets, and the real recordings) and
+their outputs are compared byte for byte, negative zeros included, so the tracker's every
+figure is the same whichever is installed.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from people_tracker.detection import compiled
+from people_tracker.detection.compiled import beam_of
+from people_tracker.detection.leg_features import leg_candidates
+from people_tracker.models.scan import beam_index
+from people_tracker.models.scenario import build_simulation, load_scenario
+
+pytestmark = pytest.mark.skipif(not compiled.ENABLED, reason="numba is not installed (the [fast] extra) "
+                                "or PEOPLE_TRACKER_COMPILED=0: only the numpy path runs")
+
+DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "leigh"
+
+LASERS = {  # every kind of laser: narrow and wide, clockwise, a full turn; lost readings as nan and as 0
+    "narrow": {"fov_deg": 86, "resolution_deg": 0.35, "rate_hz": 10, "range_max": 5.6, "dropout": 0.01},
+    "clockwise": {"fov_deg": 270, "resolution_deg": 0.5, "rate_hz": 12.5, "range_max": 29, "clockwise": True,
+                  "dropout": 0.02, "dropout_value": "zero", "spurious": 0.005},
+    "full_turn": {"fov_deg": 360, "resolution_deg": 1.0, "rate_hz": 10, "range_max": 12, "dropout": 0.02},
+}
+
+
+def _simulated(laser: dict, seconds: float = 6.0):
+    spec = {**load_scenario("crowd"), "duration_s": seconds, "laser": {**load_scenario("crowd")["laser"], **laser}}
+    sim, n = build_simulation(spec, crowd_count=12)
+    return [sim.step().scan for _ in range(n)]
+
+
+def _real(name: str, topic: str | None = None, limit: int = 300):
+    path = DATA / name
+    if not path.exists():
+        pytest.skip(f"{path} not found: the real recordings live in ../shared/data")
+    from people_tracker.tracker.config import load_config
+    from people_tracker.tracker.io.recording import Recording
+    with Recording(path, topic, load_config().odometry) as rec:
+        return [r.scan for r, _ in zip(rec.scans(), range(limit)) if r.scan is not None]
+
+
+def _same(a, b, what: str) -> None:
+    for field in ("first_beam", "last_beam", "start", "stop", "xy", "features"):
+        x, y = getattr(a, field), getattr(b, field)
+        assert x.dtype == y.dtype and x.shape == y.shape, f"{what}: {field} {x.dtype}{x.shape} vs {y.dtype}{y.shape}"
+        assert x.tobytes() == y.tobytes(), f"{what}: {field} differs by up to {np.nanmax(np.abs(x - y))}"
+
+
+def _agree(scans, what: str) -> int:
+    found = 0
+    for i, scan in enumerate(scans):
+        fast = leg_candidates(scan)
+        with compiled.numpy_only():
+            ref = leg_candidates(scan)
+        _same(fast, ref, f"{what} scan {i}")
+        found += len(fast)
+    return found
+
+
+@pytest.mark.parametrize("laser", sorted(LASERS))
+def test_leg_features_agree_on_simulated_lasers(laser):
+    assert _agree(_simulated(LASERS[laser]), laser) > 100
+
+
+@pytest.mark.parametrize("name, topic", [("general_tracking_moving_1.bag", None),
+                                         ("negative_2.bag", "/rear_scan"),
+                                         ("training/positive_4_extracted.bag", None)])
+def test_leg_features_agree_on_real_recordings(name, topic):
+    assert _agree(_real(name, topic), name) > 100
+
+
+def test_bearing_to_beam_agrees_with_beam_index():
+    rng = np.random.default_rng(3)
+    for n, inc in ((768, np.radians(0.35)), (811, -np.radians(1 / 3)), (1440, np.radians(0.25)),
+                   (360, np.radians(1.0)), (541, -np.radians(0.5))):
+        for amin in (-np.pi, -0.5 * n * abs(inc), 0.3, 0.9 * np.pi):
+            amin = -amin if inc < 0 else amin
+            grid = amin + inc * np.arange(-3, n + 3)  # every beam, the edges, and half-way between
+            bearing = np.concatenate([rng.uniform(-7, 7, 500), grid, grid + 0.5 * inc])
+            got = np.array([beam_of(b, amin, inc, n) for b in bearing])
+            assert np.array_equal(got, beam_index(bearing, amin, inc, n)), (n, inc, amin)
+
+
+def test_numpy_only_switches_the_kernels_off_and_back():
+    assert compiled.on
+    with compiled.numpy_only():
+        assert not compiled.on
+    assert compiled.on
+
+
+def _trace(steps) -> list[bytes]:
+    """What the tracker gives, scan by scan, as bytes: labels, leg features, objects, the
+    world pose, candidates and reported tracks."""
+    from people_tracker.tracker.config import load_config
+    from people_tracker.tracker.people_tracker import PeopleTracker
+    tracker, out = PeopleTracker.from_config(load_config()), []
+    for scan, pose, pose_last in steps:
+        tracks = tracker.step(scan, pose, pose_last)
+        last = tracker.last
+        out.append(b"".join([
+            last.detection.labels.tobytes(), last.legs.features.tobytes(), last.leg_scores.tobytes(),
+            np.array([(o.x, o.y, o.width, o.length) for o in last.detection.objects]).tobytes(),
+            np.array([last.pose.x, last.pose.y, last.pose.yaw]).tobytes(),
+            np.array([(c.x, c.y) for c in [*last.candidates, *last.standing]]).tobytes(),
+            np.array([(t.track_id, t.x, t.y, t.vx, t.vy, t.confidence) for t in tracks]).tobytes()]))
+    return out
+
+
+def _tracker_agrees(steps, what: str) -> None:
+    fast = _trace(steps)
+    with compiled.numpy_only():
+        ref = _trace(steps)
+    first = next((i for i, (a, b) in enumerate(zip(fast, ref)) if a != b), None)
+    assert first is None, f"{what}: the tracker's outputs differ from scan {first} on"
+
+
+@pytest.mark.parametrize("scene, laser", [("crowd", None), ("follow_outdoor", "long_cw")])
+def test_the_tracker_gives_the_same_with_and_without_kernels_on_simulated_scenes(scene, laser):
+    spec = {**load_scenario(scene), "duration_s": 20.0}
+    sim, n = build_simulation(spec, laser=laser) if laser else build_simulation(spec)
+    steps = []
+    for _ in range(n):
+        st = sim.step()
+        steps.append((st.scan, st.odom_pose @ sim.mount if sim.has_odometry else None, None))
+    _tracker_agrees(steps, scene)
+
+
+def test_the_tracker_gives_the_same_with_and_without_kernels_on_the_real_recording():
+    path = DATA / "general_tracking_moving_1.bag"
+    if not path.exists():
+        pytest.skip(f"{path} not found: the real recordings live in ../shared/data")
+    from people_tracker.tracker.config import load_config
+    from people_tracker.tracker.io.recording import Recording
+    with Recording(path, None, load_config().odometry) as rec:
+        steps = [(r.scan, r.pose, r.pose_last_beam) for r, _ in zip(rec.scans(), range(400)) if r.scan is not None]
+    _tracker_agrees(steps, path.name)
