@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from people_tracker.detection import compiled
+from people_tracker.detection.compiled import beam_of, njit
 from people_tracker.models.pose import Pose2D
 from people_tracker.models.scan import Scan, beam_index
 
@@ -68,6 +70,12 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
     increment = scan.angle_increment + motion.yaw / (n - 1)
     if increment * scan.angle_increment <= 0 or abs(increment) < 0.5 * abs(scan.angle_increment):
         increment = scan.angle_increment
+    if compiled.on:  # the rest as one compiled loop, the same arithmetic
+        out, source, bearings = _deskew_kernel(scan.ranges, scan.valid_index, scan.angles, scan.no_return, motion.x,
+                                               motion.y, motion.yaw, scan.angle_min, increment, scan.range_min,
+                                               scan.range_max)
+        return Scan(out, scan.angle_min, increment, scan.range_min, scan.range_max, scan.stamp,
+                    scan.frame_id, scan.time_increment, bearings), source
     frac = np.arange(n) / (n - 1)
     # per-beam sensor pose relative to the first beam: linear in translation and heading
     yaw = frac * motion.yaw
@@ -91,3 +99,36 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
     bearings[idx[keep][order]] = bearing[keep][order]
     return Scan(out, scan.angle_min, increment, scan.range_min, scan.range_max, scan.stamp,
                 scan.frame_id, scan.time_increment, bearings), source
+
+
+def _deskew_loop(ranges, valid, angles, no_return, mx, my, myaw, angle_min, increment, range_min, range_max):
+    """:func:`deskew_with_source` from its new grid on, for the sweep's motion (mx, my,
+    myaw) in the first beam's frame, as one loop (compiled by numba; the numpy code above is
+    the reference): the new ranges, the source beams and the bearings."""
+    n = len(ranges)
+    out = np.empty(n)
+    for i in range(n):
+        out[i] = np.inf if no_return[i] else np.nan
+    source = np.full(n, -1, np.int64)
+    bearings = np.empty(n)
+    for i in range(n):
+        bearings[i] = angle_min + i * increment
+    best = np.full(n, np.inf)  # the nearest reading written to each beam so far
+    for i in valid:
+        frac = i / (n - 1)
+        a = angles[i] + frac * myaw
+        x = frac * mx + ranges[i] * np.cos(a)
+        y = frac * my + ranges[i] * np.sin(a)
+        new_r = np.hypot(x, y)
+        bearing = np.arctan2(y, x)
+        b = beam_of(bearing, angle_min, increment, n)
+        # the nearest in a beam wins; of equally near ones the later (the stable sort's last write)
+        if b >= 0 and new_r > range_min and new_r < range_max and new_r <= best[b]:
+            best[b] = new_r
+            out[b] = new_r
+            source[b] = i
+            bearings[b] = bearing
+    return out, source, bearings
+
+
+_deskew_kernel = njit(_deskew_loop)

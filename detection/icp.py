@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg.lapack import dsyev
 
+from people_tracker.detection import compiled
+from people_tracker.detection.compiled import njit
 from people_tracker.detection.kdtree import PointTree
 from people_tracker.models.pose import Pose2D, wrap_angle
 
@@ -190,21 +192,29 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         c, s = math.cos(th), math.sin(th)
         p = src @ np.array([[c, s], [-s, c]]) + (x, y)  # R p + t, in the reference frame
         _, j = reference.tree.query(p, gate)
-        found = reference.usable_or_none[j]  # none within the gate, or a partner without a normal: no line
-        if np.count_nonzero(found) < params.min_pairs:
-            return fail("too few correspondences", it=it)
-        j = j[found]
-        p, q, nq = p[found], reference.points[j], reference.normals[j]
-        r = np.einsum("ij,ij->i", p - q, nq)  # point-to-line residual
-        # trimmed: keep the best share of the pairs (a partition, not a sort)
-        absr = np.abs(r)
-        k = int(params.trim_fraction * (len(absr) - 1))
-        keep = absr <= np.partition(absr, k)[k]
-        p, nq, r = p[keep], nq[keep], r[keep]
-        # Jacobian of n·(R(dθ) p + d - q) at zero: [n_x, n_y, n·(J p)], J p = (-p_y, p_x)
-        A = np.empty((len(r), 3))
-        A[:, :2] = nq
-        A[:, 2] = nq[:, 1] * p[:, 0] - nq[:, 0] * p[:, 1]
+        if compiled.on:  # the pairs, their trimming and the Jacobian as one compiled loop
+            n_found, p, r, A = _pairs_kernel(p, j, reference.usable_or_none, reference.points, reference.normals,
+                                             params.trim_fraction)
+            if n_found < params.min_pairs:
+                return fail("too few correspondences", it=it)
+            n_keep = len(r)
+        else:
+            found = reference.usable_or_none[j]  # none within the gate, or a partner without a normal: no line
+            if np.count_nonzero(found) < params.min_pairs:
+                return fail("too few correspondences", it=it)
+            j = j[found]
+            p, q, nq = p[found], reference.points[j], reference.normals[j]
+            r = np.einsum("ij,ij->i", p - q, nq)  # point-to-line residual
+            # trimmed: keep the best share of the pairs (a partition, not a sort)
+            absr = np.abs(r)
+            k = int(params.trim_fraction * (len(absr) - 1))
+            keep = absr <= np.partition(absr, k)[k]
+            p, nq, r = p[keep], nq[keep], r[keep]
+            n_keep = int(keep.sum())
+            # Jacobian of n·(R(dθ) p + d - q) at zero: [n_x, n_y, n·(J p)], J p = (-p_y, p_x)
+            A = np.empty((len(r), 3))
+            A[:, :2] = nq
+            A[:, 2] = nq[:, 1] * p[:, 0] - nq[:, 0] * p[:, 1]
         Hm = A.T @ A
         g = A.T @ r
         # the rotation column measured in metres at the scene's typical range, for a fair comparison
@@ -223,7 +233,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         x, y = cd * x - sd * y + dx, sd * x + cd * y + dy
         th = float(wrap_angle(th + dth))
         rms = math.sqrt(float(r @ r) / len(r))
-        overlap = float(keep.sum() / n_src)
+        overlap = float(n_keep / n_src)
         gate = max(params.min_correspondence_m, gate * 0.5)
         if it >= 2 and abs(dx) < 2e-3 and abs(dy) < 2e-3 and abs(dth) < 2e-4:
             break  # settled: a further step would move a reading less than 1 mm (at 10 m)
@@ -236,3 +246,45 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
     if math.hypot(correction.x, correction.y) > params.max_correction_m or abs(correction.yaw) > params.max_correction_rad:
         return fail("result too far from the prior", rms, overlap, cond, it)
     return MatchResult(result, True, rms, overlap, cond, degenerate, it)
+
+
+def _pairs_loop(p, j, usable_or_none, ref_points, ref_normals, trim_fraction):
+    """One ICP iteration's pairs as :func:`match` makes them in numpy (the reference): the
+    readings ``p`` (reference frame) whose nearest reference reading ``j`` has a normal,
+    their point-to-line residuals, the best ``trim_fraction`` of them kept, and the
+    Jacobian rows. Returns the number paired, the kept readings, residuals and Jacobian."""
+    n = len(p)
+    found = np.empty(n, np.int64)
+    m = 0
+    for i in range(n):
+        if usable_or_none[j[i]]:
+            found[m] = i
+            m += 1
+    r = np.empty(m)
+    for t in range(m):
+        i, q = found[t], j[found[t]]
+        # einsum's dot product: from +0.0
+        r[t] = 0.0 + (p[i, 0] - ref_points[q, 0]) * ref_normals[q, 0] + (p[i, 1] - ref_points[q, 1]) * ref_normals[q, 1]
+    absr = np.abs(r)
+    k = int(trim_fraction * (m - 1))
+    bound = np.partition(absr, k)[k] if m > 0 else 0.0
+    n_keep = 0
+    for t in range(m):
+        if absr[t] <= bound:
+            n_keep += 1
+    kept_p = np.empty((n_keep, 2))
+    kept_r = np.empty(n_keep)
+    jac = np.empty((n_keep, 3))
+    c = 0
+    for t in range(m):
+        if absr[t] <= bound:
+            i, q = found[t], j[found[t]]
+            kept_p[c, 0], kept_p[c, 1] = p[i, 0], p[i, 1]
+            kept_r[c] = r[t]
+            jac[c, 0], jac[c, 1] = ref_normals[q, 0], ref_normals[q, 1]
+            jac[c, 2] = ref_normals[q, 1] * p[i, 0] - ref_normals[q, 0] * p[i, 1]
+            c += 1
+    return m, kept_p, kept_r, jac
+
+
+_pairs_kernel = njit(_pairs_loop)

@@ -13,7 +13,9 @@ import pytest
 
 from people_tracker.detection import compiled
 from people_tracker.detection.compiled import beam_of
+from people_tracker.detection.deskew import deskew_with_source
 from people_tracker.detection.leg_features import leg_candidates
+from people_tracker.models.pose import Pose2D
 from people_tracker.models.scan import beam_index
 from people_tracker.models.scenario import build_simulation, load_scenario
 
@@ -74,6 +76,20 @@ def test_leg_features_agree_on_simulated_lasers(laser):
                                          ("training/positive_4_extracted.bag", None)])
 def test_leg_features_agree_on_real_recordings(name, topic):
     assert _agree(_real(name, topic), name) > 100
+
+
+@pytest.mark.parametrize("laser", sorted(LASERS))
+def test_deskew_agrees_on_simulated_lasers(laser):
+    rng = np.random.default_rng(7)
+    for scan in _simulated(LASERS[laser], seconds=2.0):
+        first = Pose2D(*rng.uniform(-2, 2, 2), rng.uniform(-3, 3))
+        last = first @ Pose2D(*rng.normal(0, 0.08, 2), rng.normal(0, 0.1))  # up to ~2 m/s and 6 rad/s a sweep
+        fast, src = deskew_with_source(scan, first, last)
+        with compiled.numpy_only():
+            ref, ref_src = deskew_with_source(scan, first, last)
+        assert src.tobytes() == ref_src.tobytes()
+        assert fast.ranges.tobytes() == ref.ranges.tobytes() and fast.bearings.tobytes() == ref.bearings.tobytes()
+        assert fast.angle_increment == ref.angle_increment
 
 
 def test_bearing_to_beam_agrees_with_beam_index():
