@@ -107,6 +107,8 @@ def line_normals(points: np.ndarray, max_gap: float, half_width: int = 2) -> np.
     points : ndarray, shape (n, 2)
         Valid readings in beam order, metres.
     """
+    if compiled.on:
+        return _normals_kernel(points, max_gap, half_width)
     n = len(points)
     k = half_width
     normals = np.full((n, 2), np.nan)
@@ -288,3 +290,30 @@ def _pairs_loop(p, j, usable_or_none, ref_points, ref_normals, trim_fraction):
 
 
 _pairs_kernel = njit(_pairs_loop)
+
+
+def _normals_loop(points, max_gap, k):
+    """:func:`line_normals` as one loop (compiled by numba; the numpy code is the reference)."""
+    n = len(points)
+    normals = np.full((n, 2), np.nan)
+    if n < 2 * k + 1:
+        return normals
+    short = np.empty(n - 1, np.bool_)
+    for i in range(n - 1):
+        short[i] = np.hypot(points[i + 1, 0] - points[i, 0], points[i + 1, 1] - points[i, 1]) < max_gap
+    for i in range(k, n - k):
+        ok = True
+        for s in range(i - k, i + k):
+            if not short[s]:
+                ok = False
+                break
+        if not ok:
+            continue
+        tx, ty = points[i + k, 0] - points[i - k, 0], points[i + k, 1] - points[i - k, 1]
+        length = np.hypot(tx, ty)
+        if length > 1e-9:
+            normals[i, 0], normals[i, 1] = -ty / length, tx / length
+    return normals
+
+
+_normals_kernel = njit(_normals_loop)

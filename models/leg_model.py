@@ -25,6 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
+from people_tracker.detection import compiled
+from people_tracker.detection.compiled import njit
+
 SHIPPED = "leg_model.npz"
 
 
@@ -70,6 +73,8 @@ class LegModel:
         if len(x) == 0:
             return np.zeros(0)
         feature, threshold, leaves = self._heap  # complete trees in heap order: children 2i+1, 2i+2
+        if compiled.on:  # the walk compiled; the sum stays numpy's (its order of additions)
+            return self.init + _leaf_values_kernel(x, feature, threshold, leaves, self.depth).sum(axis=1)
         n_trees = len(feature)
         base = (np.arange(n_trees) * feature.shape[1])[None, :]
         rows = (np.arange(len(x)) * x.shape[1])[:, None]
@@ -169,3 +174,20 @@ def load_leg_model(path: str | Path | None = None) -> LegModel:
             or len(model.calib_raw) < 2 or model.feature.max(initial=0) >= len(model.feature_names):
         raise LegModelError(f"{where} is malformed")
     return model
+
+
+def _leaf_values_loop(x, feature, threshold, leaves, depth):
+    """Each row of ``x`` walked down every complete tree (:meth:`LegModel.log_odds`' numpy
+    walk is the reference): the leaf values it ends on, shape (len(x), n_trees)."""
+    n_trees, n_inner = feature.shape
+    out = np.empty((len(x), n_trees))
+    for i in range(len(x)):
+        for t in range(n_trees):
+            node = 0
+            for _ in range(depth):
+                node = 2 * node + (2 if x[i, feature[t, node]] > threshold[t, node] else 1)
+            out[i, t] = leaves[t, node - n_inner]
+    return out
+
+
+_leaf_values_kernel = njit(_leaf_values_loop)

@@ -92,6 +92,19 @@ def test_deskew_agrees_on_simulated_lasers(laser):
         assert fast.angle_increment == ref.angle_increment
 
 
+@pytest.mark.parametrize("laser", sorted(LASERS))
+def test_leg_scores_and_line_normals_agree_on_simulated_lasers(laser):
+    from people_tracker.detection.icp import line_normals
+    from people_tracker.models.leg_model import load_leg_model
+    model = load_leg_model()
+    for scan in _simulated(LASERS[laser], seconds=2.0):
+        feats = leg_candidates(scan).features
+        fast, normals = model.log_odds(feats), line_normals(scan.valid_points, 0.2)
+        with compiled.numpy_only():
+            assert fast.tobytes() == model.log_odds(feats).tobytes()
+            assert normals.tobytes() == line_normals(scan.valid_points, 0.2).tobytes()
+
+
 def test_bearing_to_beam_agrees_with_beam_index():
     rng = np.random.default_rng(3)
     for n, inc in ((768, np.radians(0.35)), (811, -np.radians(1 / 3)), (1440, np.radians(0.25)),
