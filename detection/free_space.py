@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from people_tracker.detection import compiled
+from people_tracker.detection.compiled import beam_of, njit
 from people_tracker.detection.scan_lines import bin_to_beams
 from people_tracker.models.pose import Pose2D
 from people_tracker.models.scan import Scan
@@ -75,6 +77,9 @@ def place_visibility(points_world: np.ndarray, scan: Scan, pose: Pose2D, radius_
         return out
     local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
     dist = np.hypot(local[:, 0], local[:, 1])
+    if compiled.on:  # the loop below, compiled
+        return _visibility_kernel(local, dist, scan.ranges, scan.valid, scan.no_return, scan.angle_min,
+                                  scan.angle_increment, radius_m, no_return_free_m)
     centre = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
     inc = abs(scan.angle_increment)
     for k in np.flatnonzero((centre >= 0) & (dist > radius_m)):
@@ -91,6 +96,42 @@ def place_visibility(points_world: np.ndarray, scan: Scan, pose: Pose2D, radius_
         elif valid.sum() + free.sum() >= 0.5 * (hi - lo):
             out[k] = SEEN_THROUGH
     return out
+
+
+def _visibility_loop(local, dist, ranges, valid, no_return, angle_min, angle_increment, radius_m, no_return_free_m):
+    """:func:`place_visibility` from the places in the sensor frame on, as one loop
+    (compiled by numba; the numpy code is the reference)."""
+    n_beams = len(ranges)
+    inc = abs(angle_increment)
+    out = np.full(len(local), UNSEEN, np.int8)
+    for k in range(len(local)):
+        centre = beam_of(np.arctan2(local[k, 1], local[k, 0]), angle_min, angle_increment, n_beams)
+        if centre < 0 or not dist[k] > radius_m:
+            continue
+        half = int(np.ceil(np.arcsin(min(1.0, radius_m / dist[k])) / inc))
+        lo, hi = max(0, centre - half), min(n_beams, centre + half + 1)
+        reach = dist[k] + radius_m <= no_return_free_m
+        occupied = occluded = False
+        count = 0
+        for b in range(lo, hi):
+            if valid[b]:
+                count += 1
+                if np.abs(ranges[b] - dist[k]) <= radius_m:
+                    occupied = True
+                elif ranges[b] < dist[k] - radius_m:
+                    occluded = True
+            elif no_return[b] and reach:
+                count += 1
+        if occupied:
+            out[k] = OCCUPIED
+        elif occluded:
+            out[k] = OCCLUDED
+        elif count >= 0.5 * (hi - lo):
+            out[k] = SEEN_THROUGH
+    return out
+
+
+_visibility_kernel = njit(_visibility_loop)
 
 
 class PlaceMemory:

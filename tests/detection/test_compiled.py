@@ -105,6 +105,22 @@ def test_leg_scores_and_line_normals_agree_on_simulated_lasers(laser):
             assert normals.tobytes() == line_normals(scan.valid_points, 0.2).tobytes()
 
 
+@pytest.mark.parametrize("laser", sorted(LASERS))
+def test_place_visibility_agrees_on_simulated_lasers(laser):
+    from people_tracker.detection.free_space import place_visibility
+    rng = np.random.default_rng(11)
+    codes = set()
+    for scan in _simulated(LASERS[laser], seconds=2.0):
+        pose = Pose2D(*rng.uniform(-1, 1, 2), rng.uniform(-3, 3))
+        places = pose.transform_points(rng.uniform(-8, 8, (60, 2)))  # in view and not, near and far
+        for radius, reach in ((0.25, np.inf), (0.4, 3.0), (0.1, 0.0)):
+            fast = place_visibility(places, scan, pose, radius, reach)
+            with compiled.numpy_only():
+                assert fast.tobytes() == place_visibility(places, scan, pose, radius, reach).tobytes()
+            codes |= set(fast.tolist())
+    assert codes == {0, 1, 2, 3}  # every outcome was compared
+
+
 def test_bearing_to_beam_agrees_with_beam_index():
     rng = np.random.default_rng(3)
     for n, inc in ((768, np.radians(0.35)), (811, -np.radians(1 / 3)), (1440, np.radians(0.25)),
