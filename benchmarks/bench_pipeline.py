@@ -4,7 +4,11 @@ Usage::
 
     python benchmarks/bench_pipeline.py [BAG] [--people 10 50 100] [--hour]
 
-Its parts, each on one core (the process pins itself to its first allowed CPU):
+Its parts, each on one core (the process pins itself to its first allowed CPU). The first
+line says whether the compiled kernels run (numba, the ``[fast]`` extra; see
+``detection/compiled.py``); when they do, the real recording is also timed with the numpy
+code alone, in-process and as a whole program (``PEOPLE_TRACKER_COMPILED=0``), so the
+kernels' share shows:
 
 * **in-process**: on the real recording each scan's time covers reading it (with its
   poses) from the bag and the tracker's step; on the crowd scene (one row per ``--people``)
@@ -40,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
+from people_tracker.detection import compiled
 from people_tracker.models.scenario import build_simulation, load_scenario
 from people_tracker.tracker.config import load_config
 from people_tracker.tracker.io.recording import Recording
@@ -81,21 +86,21 @@ def bench_crowd(people: int, config, scans: int) -> tuple[list[float], float]:
     return times, reported / max(len(times), 1)
 
 
-def run_program(bag: Path, out: Path, repeat: int = 3) -> tuple[int, float]:
+def run_program(bag: Path, out: Path, repeat: int = 3, env: dict | None = None) -> tuple[int, float]:
     """Scans read and the best wall time (s) of ``people-tracker run BAG --tracks`` on this core."""
     cmd = [sys.executable, "-m", "people_tracker", "run", str(bag), "--tracks", str(out)]
     best, scans = float("inf"), 0
     for _ in range(repeat):
         t0 = time.perf_counter()
-        done = subprocess.run(cmd, capture_output=True, text=True, check=True)
+        done = subprocess.run(cmd, capture_output=True, text=True, check=True, env=env)
         best = min(best, time.perf_counter() - t0)
         m = re.search(r"scans: (\d+) read", done.stderr + done.stdout)
         scans = int(m.group(1)) if m else 0
     return scans, best
 
 
-def _marginal(name: str, long: Path, short: Path, out: Path) -> None:
-    (n1, t1), (n2, t2) = run_program(long, out), run_program(short, out)
+def _marginal(name: str, long: Path, short: Path, out: Path, env: dict | None = None) -> None:
+    (n1, t1), (n2, t2) = run_program(long, out, env=env), run_program(short, out, env=env)
     rate = (n1 - n2) / (t1 - t2) if t1 > t2 else float("nan")
     print(f"{name:<44} {rate:>8.0f}   ({n1} scans in {t1:.2f} s, {n2} in {t2:.2f} s)")
 
@@ -106,6 +111,9 @@ def bench_whole_program() -> None:
         out = Path(tmp) / "t.csv"
         if DEFAULT_BAG.exists() and SHORT_BAG.exists():
             _marginal("moving_1.bag (873) - positive_2.bag (243)", DEFAULT_BAG, SHORT_BAG, out)
+            if compiled.ENABLED:
+                _marginal("  the same, numpy only", DEFAULT_BAG, SHORT_BAG, out,
+                          {**os.environ, "PEOPLE_TRACKER_COMPILED": "0"})
         else:
             print("real recordings: not found (they live in ../shared/data)")
         bags = []
@@ -195,10 +203,16 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     _one_core()
     config = load_config()
+    print("compiled kernels: " + (f"on (numba {compiled.numba_version()})" if compiled.ENABLED else
+                                  "off, numpy only (install the [fast] extra, or PEOPLE_TRACKER_COMPILED is 0)"))
     print(f"{'pipeline':<44} {'scans/s':>8} {'p50 ms':>8} {'p99 ms':>8}  tracks/scan")
     if Path(args.bag).exists():
         times, per = _best(lambda: bench_recording(Path(args.bag), config))
         _row(f"{Path(args.bag).name} (read+track)", times, f"{per:.2f}")
+        if compiled.ENABLED:
+            with compiled.numpy_only():
+                times, per = _best(lambda: bench_recording(Path(args.bag), config))
+            _row("  the same, numpy only", times, f"{per:.2f}")
     else:
         print(f"{Path(args.bag).name}: not found (the real recordings live in ../shared/data)")
     for people in args.people:

@@ -50,6 +50,11 @@ def numpy_only():
         on = saved
 
 
+def numba_version() -> str | None:
+    """The numba that compiles the kernels, None when they are off."""
+    return _numba.__version__ if _numba is not None else None
+
+
 def njit(fn):
     """``fn`` compiled (no Python objects, cached on disk) when numba is on; else None."""
     if _numba is None:
