@@ -55,11 +55,18 @@ def numba_version() -> str | None:
     return _numba.__version__ if _numba is not None else None
 
 
-def njit(fn):
-    """``fn`` compiled (no Python objects, cached on disk) when numba is on; else None."""
+KERNELS: list = []  # every kernel the pipeline calls (not the helpers they call), for the warm-up's test
+
+
+def njit(fn, helper: bool = False):
+    """``fn`` compiled (no Python objects, cached on disk) when numba is on; else None.
+    ``helper``: only called from other kernels (compiled into them)."""
     if _numba is None:
         return None
-    return _numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")(fn)
+    kernel = _numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")(fn)
+    if not helper:
+        KERNELS.append(kernel)
+    return kernel
 
 
 # Helpers the kernels share: plain functions, compiled with them (None-safe: without
@@ -152,7 +159,7 @@ def beam_of(bearing, angle_min, angle_increment, n_beams):
 
 
 
-_block = njit(_block) or _block
-_pairwise = njit(_pairwise) or _pairwise
-add_reduce = njit(add_reduce) or add_reduce
-beam_of = njit(beam_of) or beam_of
+_block = njit(_block, helper=True) or _block
+_pairwise = njit(_pairwise, helper=True) or _pairwise
+add_reduce = njit(add_reduce, helper=True) or add_reduce
+beam_of = njit(beam_of, helper=True) or beam_of

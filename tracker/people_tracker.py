@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -800,3 +801,31 @@ def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:
 
 
 __all__ = ["AssociationParams", "PeopleTracker", "StepResult", "tracks_in_sensor_frame"]
+
+
+def warm_up_kernels(config=None) -> float:
+    """Compile the compiled kernels (the first time on a machine, about half a minute) or
+    load them from numba's cache (well under a second), by tracking four seconds of the
+    simulated ``crossing`` scene with odometry and without, so that every kernel meets the
+    argument types the pipeline gives it. A live node calls it before it subscribes: left
+    to the first scans, the loading would queue and drop them. Returns the seconds it took
+    (0 without the kernels)."""
+    from people_tracker.detection import compiled
+    from people_tracker.detection.free_space import place_visibility
+    from people_tracker.models.scenario import build_simulation, load_scenario
+    from people_tracker.tracker.config import load_config
+
+    if not compiled.ENABLED:
+        return 0.0
+    t0 = time.perf_counter()
+    config = config or load_config()
+    for odometry in (True, False):
+        sim, n = build_simulation({**load_scenario("crossing"), "duration_s": 4.0})
+        tracker = PeopleTracker.from_config(config)
+        for _ in range(n):
+            st = sim.step()
+            tracker.step(st.scan, st.odom_pose if odometry else None, st.odom_pose_last_beam if odometry else None)
+        last = tracker.last  # where no track coasted: the place test on its own
+        place_visibility(np.array([[1.0, 0.5], [3.0, -1.0]]), last.scan, last.pose, config.existence.place_radius_m,
+                         tracker.detector.params.no_return_free_m)
+    return time.perf_counter() - t0

@@ -104,7 +104,7 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
     from people_tracker.detection.deskew import sweep_duration
     from people_tracker.tracker.io.bag import stamp_seconds
     from people_tracker.tracker.io.odometry import PoseSeries, pose_from_msg
-    from people_tracker.tracker.people_tracker import PeopleTracker
+    from people_tracker.tracker.people_tracker import PeopleTracker, warm_up_kernels
     from people_tracker.tracker.scan_checks import ScanChecker
 
     rclpy.init(args=ros_args)
@@ -126,6 +126,11 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
             raise InputError(f"--follow takes auto or a track id, got '{p['follow']}'")
         follow = p["follow"] if p["follow"] == "auto" else int(p["follow"])
     tracker = PeopleTracker.from_config(config, follow)
+    # the compiled kernels loaded (or, the first time on this machine, compiled) before the
+    # first scan comes: loading them on it would queue scans and drop some
+    warm_s = warm_up_kernels(config)
+    if warm_s > 2.0:
+        log.info("compiled the tracker's kernels in %.0f s (once on this machine; cached from now on)", warm_s)
     checker = ScanChecker(config.scan_checks.stamp_jump_periods, config.scan_checks.beam_count_confirm)
     odo = config.odometry
     series = PoseSeries(odo.max_interpolation_gap_s, odo.max_extrapolation_s)

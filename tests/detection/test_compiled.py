@@ -186,3 +186,16 @@ def test_the_tracker_gives_the_same_with_and_without_kernels_on_the_real_recordi
     with Recording(path, None, load_config().odometry) as rec:
         steps = [(r.scan, r.pose, r.pose_last_beam) for r, _ in zip(rec.scans(), range(400)) if r.scan is not None]
     _tracker_agrees(steps, path.name)
+
+
+def test_the_warm_up_reaches_every_kernel():
+    """What a live node runs before its first scan loads every kernel: none is left to
+    compile (or load) on a scan. In a fresh interpreter, so nothing else loaded them."""
+    import subprocess
+    import sys
+    code = ("from people_tracker.tracker.people_tracker import warm_up_kernels\n"
+            "from people_tracker.detection import compiled\n"
+            "warm_up_kernels()\n"
+            "print(len(compiled.KERNELS), [k.py_func.__qualname__ for k in compiled.KERNELS if not k.signatures])\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split(" ", 1)
+    assert int(out[0]) >= 8 and out[1].strip() == "[]", out
