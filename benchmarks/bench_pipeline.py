@@ -6,7 +6,7 @@ Usage::
 
 Its parts, each on one core (the process pins itself to its first allowed CPU). The first
 line says whether the compiled kernels run (numba, the ``[fast]`` extra; see
-``detection/compiled.py``); when they do, the real recording and the crowd of 50 are also
+``models/compiled.py``); when they do, the real recording and the crowd of 50 are also
 timed with the numpy code alone (in-process, and the recording as a whole program with
 ``PEOPLE_TRACKER_COMPILED=0``), each run in turn with its twin, so the kernels' share shows:
 
@@ -44,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-from people_tracker.detection import compiled
+from people_tracker.models import compiled
 from people_tracker.models.scenario import build_simulation, load_scenario
 from people_tracker.tracker.config import load_config
 from people_tracker.tracker.io.recording import Recording
@@ -86,17 +86,14 @@ def bench_crowd(people: int, config, scans: int) -> tuple[list[float], float]:
     return times, reported / max(len(times), 1)
 
 
-def run_program(bag: Path, out: Path, repeat: int = 3, env: dict | None = None) -> tuple[int, float]:
-    """Scans read and the best wall time (s) of ``people-tracker run BAG --tracks`` on this core."""
+def run_program(bag: Path, out: Path, env: dict | None = None) -> tuple[int, float]:
+    """Scans read and the wall time (s) of one ``people-tracker run BAG --tracks`` on this core."""
     cmd = [sys.executable, "-m", "people_tracker", "run", str(bag), "--tracks", str(out)]
-    best, scans = float("inf"), 0
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        done = subprocess.run(cmd, capture_output=True, text=True, check=True, env=env)
-        best = min(best, time.perf_counter() - t0)
-        m = re.search(r"scans: (\d+) read", done.stderr + done.stdout)
-        scans = int(m.group(1)) if m else 0
-    return scans, best
+    t0 = time.perf_counter()
+    done = subprocess.run(cmd, capture_output=True, text=True, check=True, env=env)
+    seconds = time.perf_counter() - t0
+    m = re.search(r"scans: (\d+) read", done.stderr + done.stdout)
+    return (int(m.group(1)) if m else 0), seconds
 
 
 def _marginal(name: str, long: Path, short: Path, out: Path, numpy_too: bool = False) -> None:
@@ -107,7 +104,7 @@ def _marginal(name: str, long: Path, short: Path, out: Path, numpy_too: bool = F
     for _ in range(3):
         for k, env in enumerate(envs):
             for j, bag in enumerate((long, short)):
-                n, t = run_program(bag, out, repeat=1, env=env)
+                n, t = run_program(bag, out, env=env)
                 best[k][j] = (n, min(t, best[k][j][1]))
     for k, ((n1, t1), (n2, t2)) in enumerate(best):
         rate = (n1 - n2) / (t1 - t2) if t1 > t2 else float("nan")
@@ -193,8 +190,11 @@ def _best_both(run, repeat: int = 3, numpy_too: bool = True):
         if compiled.ENABLED and numpy_too:
             with compiled.numpy_only():
                 slow.append(run())
-    pick = lambda runs: (lambda r: (r[0], f"{r[1]:.2f}"))(min(runs, key=lambda r: sum(r[0])))  # noqa: E731
-    return pick(fast), (pick(slow) if slow else None)
+    def fastest(runs):
+        times, other = min(runs, key=lambda run: sum(run[0]))
+        return times, f"{other:.2f}"
+
+    return fastest(fast), (fastest(slow) if slow else None)
 
 
 def _one_core() -> None:

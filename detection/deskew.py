@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from people_tracker.detection import compiled
-from people_tracker.detection.compiled import beam_of, njit
+from people_tracker.models import compiled
+from people_tracker.models.compiled import beam_of, njit
 from people_tracker.models.pose import Pose2D
 from people_tracker.models.scan import Scan, beam_index
 

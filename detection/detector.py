@@ -12,7 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from people_tracker.detection import compiled
 from people_tracker.detection.closest import closest_point_static
 from people_tracker.detection.kdtree import PointTree
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
@@ -21,6 +20,7 @@ from people_tracker.detection.recover import isolated_occluded, recover_moving
 from people_tracker.detection.scan_lines import bin_to_beams, line_labels_kernel, scan_line_labels
 from people_tracker.detection.segments import split_runs
 from people_tracker.detection.thresholds import range_threshold
+from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
 

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from people_tracker.detection import compiled
-from people_tracker.detection.compiled import beam_of, njit
 from people_tracker.detection.scan_lines import bin_to_beams
+from people_tracker.models import compiled
+from people_tracker.models.compiled import bin_of, njit
 from people_tracker.models.pose import Pose2D
 from people_tracker.models.scan import Scan
 
@@ -105,7 +105,7 @@ def _visibility_loop(local, dist, ranges, valid, no_return, angle_min, angle_inc
     inc = abs(angle_increment)
     out = np.full(len(local), UNSEEN, np.int8)
     for k in range(len(local)):
-        centre = beam_of(np.arctan2(local[k, 1], local[k, 0]), angle_min, angle_increment, n_beams)
+        centre = bin_of(local[k, 0], local[k, 1], angle_min, angle_increment, n_beams)
         if centre < 0 or not dist[k] > radius_m:
             continue
         half = int(np.ceil(np.arcsin(min(1.0, radius_m / dist[k])) / inc))

@@ -13,9 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg.lapack import dsyev
 
-from people_tracker.detection import compiled
-from people_tracker.detection.compiled import njit
 from people_tracker.detection.kdtree import PointTree
+from people_tracker.models import compiled
+from people_tracker.models.compiled import njit
 from people_tracker.models.pose import Pose2D, wrap_angle
 
 
@@ -199,7 +199,6 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
                                              params.trim_fraction)
             if n_found < params.min_pairs:
                 return fail("too few correspondences", it=it)
-            n_keep = len(r)
         else:
             found = reference.usable_or_none[j]  # none within the gate, or a partner without a normal: no line
             if np.count_nonzero(found) < params.min_pairs:
@@ -212,7 +211,6 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
             k = int(params.trim_fraction * (len(absr) - 1))
             keep = absr <= np.partition(absr, k)[k]
             p, nq, r = p[keep], nq[keep], r[keep]
-            n_keep = int(keep.sum())
             # Jacobian of n·(R(dθ) p + d - q) at zero: [n_x, n_y, n·(J p)], J p = (-p_y, p_x)
             A = np.empty((len(r), 3))
             A[:, :2] = nq
@@ -235,7 +233,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         x, y = cd * x - sd * y + dx, sd * x + cd * y + dy
         th = float(wrap_angle(th + dth))
         rms = math.sqrt(float(r @ r) / len(r))
-        overlap = float(n_keep / n_src)
+        overlap = float(len(r) / n_src)  # the pairs kept
         gate = max(params.min_correspondence_m, gate * 0.5)
         if it >= 2 and abs(dx) < 2e-3 and abs(dy) < 2e-3 and abs(dth) < 2e-4:
             break  # settled: a further step would move a reading less than 1 mm (at 10 m)

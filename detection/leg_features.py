@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from people_tracker.detection import compiled
-from people_tracker.detection.compiled import add_reduce, beam_of, njit
+from people_tracker.models import compiled
+from people_tracker.models.compiled import beam_of, njit, reduceat_sum
 from people_tracker.models.scan import Scan
 
 FEATURES = (
@@ -113,10 +113,11 @@ def leg_candidates(scan: Scan, gap_m: float = 0.13, gap_beams: float = 2.5, min_
     pts = scan.valid_points
     r = scan.ranges[beams]
     res = scan.resolution
-    if compiled.on:  # the same arithmetic compiled (see detection/compiled.py)
-        valid_start, n, mean, shape, end = _shape_kernel(pts, r, res, gap_m, gap_beams, min_points, max_width_m)
+    if compiled.on:  # the same arithmetic compiled (see models/compiled.py)
+        valid_start, n, mean, shape = _shape_kernel(pts, r, res, gap_m, gap_beams, min_points, max_width_m)
         if not len(n):
             return _empty()
+        end = np.concatenate([valid_start, valid_start + n - 1])  # every first reading, then every last
         first, last = beams[valid_start], beams[valid_start + n - 1]
         features = _context_kernel(shape, mean, np.concatenate([first, last]), pts[end], r[end], scan.valid,
                                    scan.ranges, scan.points, scan.angle_min, scan.angle_increment, np.array(SIDE_OFFSETS_M),
@@ -244,8 +245,7 @@ def _shape_loop(pts, r, res, gap_m, gap_beams, min_points, max_width_m):
     """:func:`leg_candidates`' runs and their first 11 features as one loop (compiled by
     numba; the numpy code above is the reference and does the same arithmetic in the same
     order, sums included). Returns the kept runs' first reading (index into the valid
-    readings), reading count, mean (k, 2), features ``n_rel`` .. ``centre_depth_m`` (k, 11)
-    and the indices of their first readings and then their last ones (2k,)."""
+    readings), reading count, mean (k, 2) and features ``n_rel`` .. ``centre_depth_m`` (k, 11)."""
     m = len(pts)
     bounds = np.empty(m + 1, np.int64)
     bounds[0] = 0
@@ -270,21 +270,20 @@ def _shape_loop(pts, r, res, gap_m, gap_beams, min_points, max_width_m):
     count = np.empty(k, np.int64)
     mean = np.empty((k, 2))
     out = np.empty((k, 11))
-    ends = np.empty(2 * k, np.int64)
     for c in range(k):
         a, b = bounds[keep[c]], bounds[keep[c] + 1]
         n = b - a
         start[c], count[c] = a, n
-        ends[c], ends[k + c] = a, b - 1
         cx, cy = pts[b - 1, 0] - pts[a, 0], pts[b - 1, 1] - pts[a, 1]
         width = np.hypot(cx, cy)
-        mx, my = add_reduce(pts[a:b, 0]) / n, add_reduce(pts[a:b, 1]) / n
-        t = np.empty((7, n))  # per reading: u², v², uv, uq, vq, then the circle and the chord terms
+        mx, my = reduceat_sum(pts[a:b, 0]) / n, reduceat_sum(pts[a:b, 1]) / n
+        t = np.empty((5, n))  # per reading: u², v², uv, uq, vq; then the circle, boundary and chord terms
         for i in range(n):
             u, v = pts[a + i, 0] - mx, pts[a + i, 1] - my
             q = u ** 2 + v ** 2
             t[0, i], t[1, i], t[2, i], t[3, i], t[4, i] = u ** 2, v ** 2, u * v, u * q, v * q
-        suu, svv, suv, suq, svq = add_reduce(t[0]), add_reduce(t[1]), add_reduce(t[2]), add_reduce(t[3]), add_reduce(t[4])
+        suu, svv, suv, suq, svq = (reduceat_sum(t[0]), reduceat_sum(t[1]), reduceat_sum(t[2]), reduceat_sum(t[3]),
+                                   reduceat_sum(t[4]))
         det = suu * svv - suv ** 2
         ca = 0.5 * (svv * suq - suv * svq) / det
         cb = 0.5 * (suu * svq - suv * suq) / det
@@ -300,7 +299,7 @@ def _shape_loop(pts, r, res, gap_m, gap_beams, min_points, max_width_m):
             t[1, i] = step[a + i] if i < n - 1 else 0.0
             # einsum's dot product: from +0.0, so a reading on the chord gives +0.0 whatever the signs
             t[2, i] = (0.0 + (pts[a + i, 0] - pts[a, 0]) * nx + (pts[a + i, 1] - pts[a, 1]) * ny) * towards
-        boundary = add_reduce(t[1])
+        boundary = reduceat_sum(t[1])
         tr = suu + svv
         lam_min = max(0.5 * tr - np.sqrt(max(0.25 * tr ** 2 - det, 0.0)), 0.0)
         rng = np.hypot(mx, my)
@@ -310,13 +309,13 @@ def _shape_loop(pts, r, res, gap_m, gap_beams, min_points, max_width_m):
         out[c, 2] = rng
         out[c, 3] = np.sqrt(tr / n)
         out[c, 4] = radius
-        out[c, 5] = 0.0 if straight else np.sqrt(add_reduce(t[0]) / n)
+        out[c, 5] = 0.0 if straight else np.sqrt(reduceat_sum(t[0]) / n)
         out[c, 6] = np.sqrt(lam_min / n)
         out[c, 7] = boundary
         out[c, 8] = boundary / max(width, 1e-3)
-        out[c, 9] = add_reduce(t[2]) / n
+        out[c, 9] = reduceat_sum(t[2]) / n
         out[c, 10] = 0.0 if straight else np.hypot(mx + ca, my + cb) - rng
-    return start, count, mean, out, ends
+    return start, count, mean, out
 
 
 def _context_loop(shape, mean, end_beam, end_xy, end_r, valid, ranges, points, angle_min, angle_increment, offsets,

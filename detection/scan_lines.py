@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW
-from people_tracker.detection.compiled import beam_of, njit
+from people_tracker.models.compiled import bin_of, njit
 from people_tracker.models.scan import beam_index
 
 
@@ -152,10 +152,10 @@ def _line_labels_loop(beam_c, range_c, pts_p, range_p, static_p, pts_far, angle_
     beam_all = np.empty(m + f, np.int64)
     range_all = np.empty(m + f)
     for i in range(m):
-        beam_all[i] = beam_of(np.arctan2(pts_p[i, 1], pts_p[i, 0]), angle_min, angle_increment, n_beams)
+        beam_all[i] = bin_of(pts_p[i, 0], pts_p[i, 1], angle_min, angle_increment, n_beams)
         range_all[i] = range_p[i]
     for i in range(f):
-        beam_all[m + i] = beam_of(np.arctan2(pts_far[i, 1], pts_far[i, 0]), angle_min, angle_increment, n_beams)
+        beam_all[m + i] = bin_of(pts_far[i, 0], pts_far[i, 1], angle_min, angle_increment, n_beams)
         range_all[m + i] = np.hypot(pts_far[i, 0], pts_far[i, 1])
     moving_p = np.zeros(m + f, np.bool_)
     moving_p[:m] = ~static_p

@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from people_tracker.detection import compiled
-from people_tracker.detection.compiled import njit
+from people_tracker.models import compiled
+from people_tracker.models.compiled import njit
 
 SHIPPED = "leg_model.npz"
 

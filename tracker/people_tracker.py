@@ -810,7 +810,7 @@ def warm_up_kernels(config=None) -> float:
     argument types the pipeline gives it. A live node calls it before it subscribes: left
     to the first scans, the loading would queue and drop them. Returns the seconds it took
     (0 without the kernels)."""
-    from people_tracker.detection import compiled
+    from people_tracker.models import compiled
     from people_tracker.detection.free_space import place_visibility
     from people_tracker.models.scenario import build_simulation, load_scenario
     from people_tracker.tracker.config import load_config

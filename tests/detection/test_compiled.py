@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from people_tracker.detection import compiled
-from people_tracker.detection.compiled import beam_of
 from people_tracker.detection.deskew import deskew_with_source
 from people_tracker.detection.leg_features import leg_candidates
+from people_tracker.models import compiled
+from people_tracker.models.compiled import beam_of
 from people_tracker.models.pose import Pose2D
 from people_tracker.models.scan import beam_index
 from people_tracker.models.scenario import build_simulation, load_scenario
@@ -194,7 +194,7 @@ def test_the_warm_up_reaches_every_kernel():
     import subprocess
     import sys
     code = ("from people_tracker.tracker.people_tracker import warm_up_kernels\n"
-            "from people_tracker.detection import compiled\n"
+            "from people_tracker.models import compiled\n"
             "warm_up_kernels()\n"
             "print(len(compiled.KERNELS), [k.py_func.__qualname__ for k in compiled.KERNELS if not k.signatures])\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split(" ", 1)

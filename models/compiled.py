@@ -7,12 +7,16 @@ long chain of such operations, a kernel here does the same arithmetic in one com
 Every kernel has its numpy twin, which stays the reference: the kernel runs only when numba
 is installed (``pip install "people-tracker[fast]"``) and ``PEOPLE_TRACKER_COMPILED`` is not
 ``0``; ``tests/detection/test_compiled.py`` checks that the two give the same answers on real
-and simulated scans. Kernels are compiled on first use and cached beside this file (numba's
-``cache=True``), so only the first run on a machine pays the compilation.
+and simulated scans. Kernels are compiled on first use and cached beside the module that
+defines each (numba's ``cache=True``), so only the first run on a machine pays the
+compilation.
 
-The arithmetic follows the numpy code's order (sums left to right, the same expressions),
-and numba does not fuse or reorder floating-point operations unless asked to (``fastmath``
-is off), so the results agree to the last bit on every scan the test has seen.
+The arithmetic follows the numpy code's order (the same expressions; a segment's sum in
+the order ``np.add.reduceat`` adds, :func:`reduceat_sum`), and numba does not fuse or
+reorder floating-point operations unless asked to (``fastmath`` is off), so the results
+agree to the last bit on every scan the test has seen. This module sits in ``models``,
+beside :func:`people_tracker.models.scan.beam_index` whose one-bearing twin it holds, so
+that every layer can use it (the leg model too).
 """
 
 from __future__ import annotations
@@ -101,8 +105,8 @@ def _block(x, lo, n):
 
 
 def _pairwise(x, lo, n):
-    """numpy's pairwise summation of ``x[lo:lo+n]`` (the order ``np.add.reduce`` and
-    ``reduceat`` add in), so the compiled sums equal numpy's to the last bit. Longer runs
+    """numpy's pairwise summation of ``x[lo:lo+n]`` (the order ``np.add.reduceat`` adds a
+    segment in), so the compiled sums equal numpy's to the last bit. Longer runs
     than 128 split in two (the first half a multiple of 8) and add the halves' sums: the
     recursion is unrolled on a stack here (numba's on-disk cache cannot hold a recursive
     function)."""
@@ -135,8 +139,10 @@ def _pairwise(x, lo, n):
     return ret
 
 
-def add_reduce(x):
-    """``np.add.reduce(x)`` of a non-empty 1-D array: its first element, then the rest pairwise."""
+def reduceat_sum(x):
+    """The sum ``np.add.reduceat`` gives for a non-empty 1-D segment ``x``: its first
+    element, then the rest pairwise. (Not always ``np.add.reduce``'s: on a contiguous array
+    longer than 128, numpy's reduce adds in another order.)"""
     return x[0] + _pairwise(x, 1, len(x) - 1)
 
 
@@ -158,8 +164,14 @@ def beam_of(bearing, angle_min, angle_increment, n_beams):
     return -1
 
 
+def bin_of(x, y, angle_min, angle_increment, n_beams):
+    """:func:`people_tracker.detection.scan_lines.bin_to_beams` of one point (x, y), sensor
+    frame, metres: the beam whose line of sight passes nearest it, -1 outside the view."""
+    return beam_of(np.arctan2(y, x), angle_min, angle_increment, n_beams)
+
 
 _block = njit(_block, helper=True) or _block
 _pairwise = njit(_pairwise, helper=True) or _pairwise
-add_reduce = njit(add_reduce, helper=True) or add_reduce
+reduceat_sum = njit(reduceat_sum, helper=True) or reduceat_sum
 beam_of = njit(beam_of, helper=True) or beam_of
+bin_of = njit(bin_of, helper=True) or bin_of
