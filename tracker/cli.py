@@ -75,7 +75,7 @@ def _build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="run on a recording (or the built-in simulated scene)", parents=[common])
     run.add_argument("input", nargs="?", metavar="INPUT",
-                     help="a ROS 1 .bag, a ROS 2 bag folder, or an .mcap file")
+                     help="a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), or an .mcap or .db3 file")
     run.add_argument("--topic", help="LaserScan topic (default: the only one)")
     run.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
     run.add_argument("--detections", metavar="FILE.csv", help="write the moving objects of every scan")
@@ -147,7 +147,7 @@ def _build_parser() -> argparse.ArgumentParser:
                           "latency for every scan, e.g. for a recording replayed faster than it was made")
     rp = sub.add_parser("replay", help="publish a recording's scans and odometry on ROS 2 ([ros2] extra)",
                         parents=[common])
-    rp.add_argument("input", metavar="INPUT", help="a ROS 1 .bag, a ROS 2 bag folder, or an .mcap file")
+    rp.add_argument("input", metavar="INPUT", help="a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), or an .mcap or .db3 file")
     rp.add_argument("--topic", help="LaserScan topic (default: the only one)")
     rp.add_argument("--rate", type=float, default=1.0, help="times the recorded pace (%(default)s)")
     rp.add_argument("--wait", type=float, default=5.0, metavar="S",

@@ -38,7 +38,10 @@ def test_ros2_mcap_and_ros1_read_back_the_same(tmp_path):
     _, b = _read(tmp_path / "b1.bag")
     mcap_file = next((tmp_path / "b2").glob("*.mcap"))
     _, c = _read(mcap_file)  # a bare .mcap file, without metadata.yaml
-    for x, y, z in zip(a, b, c):
+    _, d = _read(tmp_path / "b2" / "metadata.yaml")  # the folder's metadata, as ros2 bag info takes it
+    assert len(a) == len(b) == len(c) == len(d)
+    for x, y, z, w in zip(a, b, c, d):
+        np.testing.assert_array_equal(x.scan.ranges, w.scan.ranges)
         np.testing.assert_array_equal(x.scan.ranges, y.scan.ranges)
         np.testing.assert_array_equal(x.scan.ranges, z.scan.ranges)
         assert x.scan.stamp == y.scan.stamp == z.scan.stamp
