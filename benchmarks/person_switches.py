@@ -1,0 +1,121 @@
+"""Why the followed person's track changes, over all tracks (Leigh et al.'s id switches).
+
+Usage::
+
+    python benchmarks/person_switches.py [--scene follow_outdoor] [--laser wide] [--seed 1] [--duration S]
+
+Runs the default tracker, without ``--follow``, on one simulated following run and keeps,
+scan by scan, the reported track on the followed person as CLEAR MOT does: the one matched
+before while it is still reported and within 0.75 m of them (sensor frame), else the
+nearest reported track within 0.75 m. Each time that track changes (an id switch of the
+following protocol) it prints the time, how long the person had no track, their range and
+bearing from the sensor, the nearest other person, the new track's age, and what became of
+the old track: deleted (by which rule of ``TrackState.dead``: its evidence of absence alone
+fell below ``existence.delete`` (its place seen through, no motion while it walks); its
+existence did; its position's uncertainty grew past ``tracks.max_position_std_m``; or
+another rule: a duplicate of someone standing, someone who set off), alive but not
+reported, or alive and how far from the person (it slid onto someone or something else).
+A count by what became of the old track closes the output. The development seeds of the
+following work are 1 and 2 (``benchmarks/following.py``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections import Counter
+
+import numpy as np
+
+from people_tracker.tracker.config import load_config
+from people_tracker.tracker.existence import logit
+from people_tracker.tracker.io.simulated import SimulatedSource
+from people_tracker.tracker.people_tracker import PeopleTracker
+
+NEAR_M = 0.75  # m: the following protocol's match distance
+
+
+def why_deleted(t) -> str:
+    """The rule of :meth:`TrackState.dead` that ends ``t`` (or another rule of the tracker)."""
+    e = t.existence
+    if e.l_dyn <= logit(e.params.delete):
+        return "deleted: evidence of absence alone"
+    if t.confirmed and e.probability < e.params.delete:
+        return "deleted: existence below existence.delete"
+    (a, b), (_, c) = t.position_cov
+    if math.sqrt(max(0.5 * (a + c) + math.sqrt(0.25 * (a - c) ** 2 + b * b), 0.0)) > t.params.max_position_std_m:
+        return "deleted: position uncertainty"
+    return "deleted: a duplicate, or set off"
+
+
+def switches(scene: str, laser: str, seed: int, duration: float | None) -> list[tuple]:
+    source = SimulatedSource(scene, seed=seed, duration=duration, laser=laser)
+    tracker = PeopleTracker.from_config(load_config())
+    person = source.sim.target_id
+    current, current_end, last_seen, t0 = None, None, None, None  # current_end: why it was deleted
+    out = []
+    for record in source.scans():
+        tracker.step(record.scan, record.pose, record.pose_last_beam)
+        stamp = record.scan.stamp
+        t0 = stamp if t0 is None else t0
+        alive = any(t is current for t in tracker._tracks)
+        if current is not None and not alive and current_end is None:
+            current_end = why_deleted(current)  # its state as the step that ended it left it
+        truth = source.truths[record.index]
+        k = int(np.flatnonzero(truth.person_id == person)[0])
+        if not truth.visible[k]:
+            continue
+        inv = tracker.last.pose.inverse()
+        where = truth.torso_sensor[k]
+
+        def dist(t) -> float:
+            return float(np.hypot(*(inv.transform_points(t.position[None])[0] - where)))
+
+        on = None
+        if current is not None and current.reported and alive and dist(current) <= NEAR_M:
+            on = current
+        else:
+            near = [(dist(t), t) for t in tracker._tracks if t.reported and dist(t) <= NEAR_M]
+            on = min(near, key=lambda dt: dt[0])[1] if near else None
+        if on is None:
+            continue
+        if current is not None and on is not current:
+            if current_end is not None:
+                what = current_end
+            elif not current.reported:
+                what = "alive, not reported"
+            else:
+                what = f"alive, {dist(current):.1f} m from the person"
+            others = [float(np.hypot(*(truth.torso_world[j] - truth.torso_world[k])))
+                      for j in range(len(truth.person_id)) if j != k]
+            out.append((stamp - t0, stamp - last_seen, float(np.hypot(*where)),
+                        math.degrees(math.atan2(where[1], where[0])), min(others, default=math.inf),
+                        stamp - on.born, what))
+        if on is not current:
+            current_end = None
+        current, last_seen = on, stamp
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scene", default="follow_outdoor")
+    ap.add_argument("--laser", default="wide")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--duration", type=float, help="seconds (default: the scene's 10 minutes)")
+    args = ap.parse_args(argv)
+    rows = switches(args.scene, args.laser, args.seed, args.duration)
+    print(f"{args.scene}, laser {args.laser}, seed {args.seed}: {len(rows)} changes of the track on the person")
+    print(f"{'time s':>7} {'gap s':>6} {'range m':>8} {'bearing':>8} {'other m':>8} {'new age s':>10}  old track")
+    for s, gap, rng, brg, other, age, what in rows:
+        near = f"{other:8.1f}" if math.isfinite(other) else f"{'-':>8}"
+        print(f"{s:7.1f} {gap:6.1f} {rng:8.1f} {brg:+7.0f}° {near} {age:10.1f}  {what}")
+    counts = Counter("alive, on someone or something else" if w.startswith("alive, ") and w.endswith("person") else w
+                     for *_, w in rows)
+    print("by what became of the old track: " + "; ".join(f"{n} {what}" for what, n in counts.most_common()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
