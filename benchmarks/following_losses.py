@@ -67,13 +67,18 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
     return out
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scene", default="follow_indoor_crowd")
+def one_run_arguments(doc: str, scene: str, seed: int, argv=None) -> argparse.Namespace:
+    """``--scene``, ``--laser``, ``--seed`` and ``--duration`` of one simulated following run."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--scene", default=scene)
     ap.add_argument("--laser", default="wide")
-    ap.add_argument("--seed", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=seed)
     ap.add_argument("--duration", type=float, help="seconds (default: the scene's 10 minutes)")
-    args = ap.parse_args(argv)
+    return ap.parse_args(argv)
+
+
+def main(argv=None) -> int:
+    args = one_run_arguments(__doc__, "follow_indoor_crowd", 2, argv)
     counts = classify(args.scene, args.laser, args.seed, args.duration)
     total = sum(counts.values())
     print(f"{args.scene}, laser {args.laser}, seed {args.seed}: {total} scans with the person visible after the first lock")

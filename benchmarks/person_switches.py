@@ -21,19 +21,20 @@ following work are 1 and 2 (``benchmarks/following.py``).
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from collections import Counter
+from pathlib import Path
 
 import numpy as np
 
-from people_tracker.tracker.config import load_config
-from people_tracker.tracker.existence import logit
-from people_tracker.tracker.io.simulated import SimulatedSource
-from people_tracker.tracker.people_tracker import PeopleTracker
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from following_losses import NEAR_M, one_run_arguments  # noqa: E402
 
-NEAR_M = 0.75  # m: the following protocol's match distance
+from people_tracker.tracker.config import load_config  # noqa: E402
+from people_tracker.tracker.existence import logit  # noqa: E402
+from people_tracker.tracker.io.simulated import SimulatedSource  # noqa: E402
+from people_tracker.tracker.people_tracker import PeopleTracker  # noqa: E402
 
 
 def why_deleted(t) -> str:
@@ -99,12 +100,7 @@ def switches(scene: str, laser: str, seed: int, duration: float | None) -> list[
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scene", default="follow_outdoor")
-    ap.add_argument("--laser", default="wide")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--duration", type=float, help="seconds (default: the scene's 10 minutes)")
-    args = ap.parse_args(argv)
+    args = one_run_arguments(__doc__, "follow_outdoor", 1, argv)
     rows = switches(args.scene, args.laser, args.seed, args.duration)
     print(f"{args.scene}, laser {args.laser}, seed {args.seed}: {len(rows)} changes of the track on the person")
     print(f"{'time s':>7} {'gap s':>6} {'range m':>8} {'bearing':>8} {'other m':>8} {'new age s':>10}  old track")
