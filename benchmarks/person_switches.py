@@ -10,7 +10,7 @@ before while it is still reported and within 0.75 m of them (sensor frame), else
 nearest reported track within 0.75 m. Each time that track changes (an id switch of the
 following protocol) it prints the time, how long the person had no track, their range and
 bearing from the sensor, the nearest other person, the new track's age, and what became of
-the old track: deleted (by which rule of ``TrackState.dead``: its evidence of absence alone
+the old track: deleted (by which rule of ``TrackState.end_reason``: its evidence of absence alone
 fell below ``existence.delete`` (its place seen through, no motion while it walks); its
 existence did; its position's uncertainty grew past ``tracks.max_position_std_m``; or
 another rule: a duplicate of someone standing, someone who set off), alive but not
@@ -32,22 +32,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from following_losses import NEAR_M, one_run_arguments  # noqa: E402
 
 from people_tracker.tracker.config import load_config  # noqa: E402
-from people_tracker.tracker.existence import logit  # noqa: E402
 from people_tracker.tracker.io.simulated import SimulatedSource  # noqa: E402
 from people_tracker.tracker.people_tracker import PeopleTracker  # noqa: E402
 
 
-def why_deleted(t) -> str:
-    """The rule of :meth:`TrackState.dead` that ends ``t`` (or another rule of the tracker)."""
-    e = t.existence
-    if e.l_dyn <= logit(e.params.delete):
-        return "deleted: evidence of absence alone"
-    if t.confirmed and e.probability < e.params.delete:
-        return "deleted: existence below existence.delete"
-    (a, b), (_, c) = t.position_cov
-    if math.sqrt(max(0.5 * (a + c) + math.sqrt(0.25 * (a - c) ** 2 + b * b), 0.0)) > t.params.max_position_std_m:
-        return "deleted: position uncertainty"
-    return "deleted: a duplicate, or set off"
+# TrackState.end_reason's rules, as the output names them
+ENDED = {"absence": "deleted: evidence of absence alone", "existence": "deleted: existence below existence.delete",
+         "tentative": "deleted: tentative too long", "uncertainty": "deleted: position uncertainty",
+         None: "deleted: a duplicate, or set off"}
+SLID = "alive, on someone or something else"
 
 
 def switches(scene: str, laser: str, seed: int, duration: float | None) -> list[tuple]:
@@ -62,7 +55,7 @@ def switches(scene: str, laser: str, seed: int, duration: float | None) -> list[
         t0 = stamp if t0 is None else t0
         alive = any(t is current for t in tracker._tracks)
         if current is not None and not alive and current_end is None:
-            current_end = why_deleted(current)  # its state as the step that ended it left it
+            current_end = ENDED[current.end_reason()]  # its state as the step that ended it left it
         truth = source.truths[record.index]
         k = int(np.flatnonzero(truth.person_id == person)[0])
         if not truth.visible[k]:
@@ -73,26 +66,26 @@ def switches(scene: str, laser: str, seed: int, duration: float | None) -> list[
         def dist(t) -> float:
             return float(np.hypot(*(inv.transform_points(t.position[None])[0] - where)))
 
-        on = None
         if current is not None and current.reported and alive and dist(current) <= NEAR_M:
             on = current
         else:
-            near = [(dist(t), t) for t in tracker._tracks if t.reported and dist(t) <= NEAR_M]
+            near = [(d, t) for d, t in ((dist(t), t) for t in tracker._tracks if t.reported) if d <= NEAR_M]
             on = min(near, key=lambda dt: dt[0])[1] if near else None
         if on is None:
             continue
         if current is not None and on is not current:
+            off_m = math.nan  # how far from the person the old track is, when it slid off them
             if current_end is not None:
                 what = current_end
             elif not current.reported:
                 what = "alive, not reported"
             else:
-                what = f"alive, {dist(current):.1f} m from the person"
+                what, off_m = SLID, dist(current)
             others = [float(np.hypot(*(truth.torso_world[j] - truth.torso_world[k])))
                       for j in range(len(truth.person_id)) if j != k]
             out.append((stamp - t0, stamp - last_seen, float(np.hypot(*where)),
                         math.degrees(math.atan2(where[1], where[0])), min(others, default=math.inf),
-                        stamp - on.born, what))
+                        stamp - on.born, what, off_m))
         if on is not current:
             current_end = None
         current, last_seen = on, stamp
@@ -104,11 +97,11 @@ def main(argv=None) -> int:
     rows = switches(args.scene, args.laser, args.seed, args.duration)
     print(f"{args.scene}, laser {args.laser}, seed {args.seed}: {len(rows)} changes of the track on the person")
     print(f"{'time s':>7} {'gap s':>6} {'range m':>8} {'bearing':>8} {'other m':>8} {'new age s':>10}  old track")
-    for s, gap, rng, brg, other, age, what in rows:
+    for s, gap, rng, brg, other, age, what, off_m in rows:
         near = f"{other:8.1f}" if math.isfinite(other) else f"{'-':>8}"
-        print(f"{s:7.1f} {gap:6.1f} {rng:8.1f} {brg:+7.0f}° {near} {age:10.1f}  {what}")
-    counts = Counter("alive, on someone or something else" if w.startswith("alive, ") and w.endswith("person") else w
-                     for *_, w in rows)
+        old = f"alive, {off_m:.1f} m from the person" if what == SLID else what
+        print(f"{s:7.1f} {gap:6.1f} {rng:8.1f} {brg:+7.0f}° {near} {age:10.1f}  {old}")
+    counts = Counter(row[6] for row in rows)
     print("by what became of the old track: " + "; ".join(f"{n} {what}" for what, n in counts.most_common()))
     return 0
 

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import os
 import sys
 import time
 from collections import Counter
@@ -27,25 +26,28 @@ from pathlib import Path
 
 import numpy as np
 
-from people_tracker.detection import detector
-from people_tracker.detection import align as align_mod
-from people_tracker.models.scenario import build_simulation, load_scenario
-from people_tracker.tracker import people_tracker as pt
-from people_tracker.tracker.config import load_config
-from people_tracker.tracker.io.recording import Recording
-from people_tracker.tracker.people_tracker import PeopleTracker, warm_up_kernels
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_pipeline import DATA, _one_core  # noqa: E402
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh"
+from people_tracker.detection import align as align_mod  # noqa: E402
+from people_tracker.detection import detector  # noqa: E402
+from people_tracker.models.scenario import build_simulation, load_scenario  # noqa: E402
+from people_tracker.tracker import people_tracker as pt  # noqa: E402
+from people_tracker.tracker.config import load_config  # noqa: E402
+from people_tracker.tracker.io.recording import Recording  # noqa: E402
+from people_tracker.tracker.people_tracker import PeopleTracker, warm_up_kernels  # noqa: E402
+
 TRACKER_STAGES = ("_candidates", "_associate", "_recover", "_standing_candidates", "_update_standing", "_support",
                   "_weigh", "_remember_standing", "_reacquire_standing", "_initiate", "_initiate_standing",
                   "_delete", "_follow", "_unmatchable_legs")
-# (module or class, attribute, label): the detector's and the aligner's parts
-PARTS = ((detector, "label_pair", "  detect: Algorithm 1 and the closest-point test"),
-         (detector.MovingObjectDetector, "_static_memory", "  detect: static memory (with carried objects)"),
-         (detector, "describe_all", "  detect: hull centroids and boxes (shapely)"),
-         (detector, "recover_moving", "  detect: Algorithms 2 and 3"),
-         (align_mod, "match", "  align: scan matching (ICP)"),
-         (align_mod, "deskew", "  align: de-skew"))
+DETECT, ALIGN = "detect: moving objects", "align: de-skew and scan matching"
+# (module or class, attribute, label, the stage it is part of): the detector's and the aligner's parts
+PARTS = ((detector, "label_pair", "detect: Algorithm 1 and the closest-point test", DETECT),
+         (detector.MovingObjectDetector, "_static_memory", "detect: static memory (with carried objects)", DETECT),
+         (detector, "describe_all", "detect: hull centroids and boxes (shapely)", DETECT),
+         (detector, "recover_moving", "detect: Algorithms 2 and 3", DETECT),
+         (align_mod, "match", "align: scan matching (ICP)", ALIGN),
+         (align_mod, "deskew", "align: de-skew", ALIGN))
 
 _spent: Counter = Counter()
 
@@ -67,13 +69,13 @@ def _timed(owner, name: str, label: str) -> None:
 
 def instrument(tracker: PeopleTracker) -> None:
     """Wrap the step's stages (once per process: the wrappers go on the classes)."""
-    _timed(type(tracker.aligner), "align", "align: de-skew and scan matching")
-    _timed(type(tracker.detector), "detect", "detect: moving objects")
+    _timed(type(tracker.aligner), "align", ALIGN)
+    _timed(type(tracker.detector), "detect", DETECT)
     _timed(type(tracker.leg_model), "probability", "leg model")
     _timed(pt, "leg_candidates", "leg candidates and features")
     for name in TRACKER_STAGES:
         _timed(PeopleTracker, name, name.strip("_").replace("_", " "))
-    for owner, name, label in PARTS:
+    for owner, name, label, _ in PARTS:
         _timed(owner, name, label)
 
 
@@ -88,19 +90,20 @@ def run(name: str, items: list, config) -> None:
             tracker.step(scan, pose, last)
             per_scan.append((time.perf_counter() - t0, dict(_spent)))
     total = np.array([t for t, _ in per_scan])
-    slow = [s for t, s in per_scan if t >= np.percentile(total, 99)]
-    labels = sorted({k for _, s in per_scan for k in s}, key=lambda k: (k.strip(), k))
+    p99 = np.percentile(total, 99)
+    slowest = [k for k, t in enumerate(total) if t >= p99]
+    labels = {k for _, s in per_scan for k in s}
     mean = {k: np.mean([s.get(k, 0.0) for _, s in per_scan]) for k in labels}
-    tail = {k: np.mean([s.get(k, 0.0) for s in slow]) for k in labels}
+    tail = {k: np.mean([per_scan[i][1].get(k, 0.0) for i in slowest]) for k in labels}
     print(f"{name}: {len(items)} scans, step {1e3 * total.mean():.2f} ms a scan (p50 {1e3 * np.median(total):.2f}, "
-          f"p99 {1e3 * np.percentile(total, 99):.2f}); the slowest 1 % ({len(slow)} scans) "
-          f"{1e3 * np.mean([t for t, _ in per_scan if t >= np.percentile(total, 99)]):.2f}")
+          f"p99 {1e3 * p99:.2f}); the slowest 1 % ({len(slowest)} scans) {1e3 * total[slowest].mean():.2f}")
     print(f"  {'stage':<52} {'ms/scan':>8} {'slowest 1 %':>12}")
-    top = [k for k in labels if not k.startswith("  ")]
+    parts = {label: parent for _, _, label, parent in PARTS}
+    top = [k for k in labels if k not in parts]
     for k in sorted(top, key=lambda k: -mean[k]):
         print(f"  {k:<52} {1e3 * mean[k]:>8.3f} {1e3 * tail[k]:>12.3f}")
-        for part in (p for p in labels if p.startswith("  " + k.split(":")[0] + ":")):
-            print(f"  {part:<52} {1e3 * mean[part]:>8.3f} {1e3 * tail[part]:>12.3f}")
+        for part in sorted(p for p in labels if parts.get(p) == k):
+            print(f"    {part:<50} {1e3 * mean[part]:>8.3f} {1e3 * tail[part]:>12.3f}")
     rest = total.mean() - sum(mean[k] for k in top)
     print(f"  {'the rest (predict, update, report, the step itself)':<52} {1e3 * rest:>8.3f}")
 
@@ -110,8 +113,7 @@ def main(argv=None) -> int:
     ap.add_argument("--people", type=int, default=50, help="crowd walkers (default 50)")
     ap.add_argument("--scans", type=int, default=300, help="crowd scans (default 300)")
     args = ap.parse_args(argv)
-    if hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+    _one_core()
     warm_up_kernels()
     config = load_config()
     instrument(PeopleTracker.from_config(config))

@@ -164,11 +164,9 @@ def _line_labels_loop(beam_c, range_c, pts_p, range_p, static_p, pts_far, angle_
     label = np.full(len(beam_c), OUT_OF_VIEW, np.int8)
     for i in range(len(beam_c)):
         p = _partner_of(beam_c[i], at_p, range_all, window)
-        if p < 0:
+        if p < 0:  # the fall-back: every earlier reading, and the free points
             p = _partner_of(beam_c[i], at_all, range_all, window)
-            if p >= 0:
-                label[i] = MOVING if range_c[i] < range_all[p] else OCCLUDED
-        else:
+        if p >= 0:
             label[i] = MOVING if range_c[i] < range_all[p] else OCCLUDED  # equal ranges: not evidence of motion
     return label
 

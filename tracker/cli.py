@@ -64,6 +64,10 @@ class _Version(argparse.Action):
         parser.exit()
 
 
+# what INPUT may be, for every command that reads a recording
+RECORDING_HELP = "a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), or an .mcap or .db3 file"
+
+
 def _build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog=PROG, description="Find and follow walking people in 2D laser scans.")
     p.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
@@ -74,8 +78,7 @@ def _build_parser() -> argparse.ArgumentParser:
     sub.required = True
 
     run = sub.add_parser("run", help="run on a recording (or the built-in simulated scene)", parents=[common])
-    run.add_argument("input", nargs="?", metavar="INPUT",
-                     help="a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), or an .mcap or .db3 file")
+    run.add_argument("input", nargs="?", metavar="INPUT", help=RECORDING_HELP)
     run.add_argument("--topic", help="LaserScan topic (default: the only one)")
     run.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
     run.add_argument("--detections", metavar="FILE.csv", help="write the moving objects of every scan")
@@ -147,7 +150,7 @@ def _build_parser() -> argparse.ArgumentParser:
                           "latency for every scan, e.g. for a recording replayed faster than it was made")
     rp = sub.add_parser("replay", help="publish a recording's scans and odometry on ROS 2 ([ros2] extra)",
                         parents=[common])
-    rp.add_argument("input", metavar="INPUT", help="a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), or an .mcap or .db3 file")
+    rp.add_argument("input", metavar="INPUT", help=RECORDING_HELP)
     rp.add_argument("--topic", help="LaserScan topic (default: the only one)")
     rp.add_argument("--rate", type=float, default=1.0, help="times the recorded pace (%(default)s)")
     rp.add_argument("--wait", type=float, default=5.0, metavar="S",

@@ -21,6 +21,7 @@ from people_tracker.detection.detector import Detection, DetectorParams, MovingO
 from people_tracker.detection.free_space import (OCCLUDED, SEEN_THROUGH, UNSEEN, PlaceMemory, place_visibility,
                                                  seen_through)
 from people_tracker.detection.leg_features import LegCandidates, leg_candidates
+from people_tracker.models import compiled
 from people_tracker.models.leg_model import LegModel, load_leg_model
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
@@ -387,7 +388,7 @@ class PeopleTracker:
         # person's. A person standing still owns no moving legs: those are a passer-by's.
         walking = [t for t in self._tracks if t.confirmed and not t.still]
         predicted = np.array([t.position for t in walking]).reshape(-1, 2)
-        groups = owners(xy, predicted, self._half_stride_m)
+        groups = owners(xy, predicted, self.pairing.half_stride_m)
         out = pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups,
                         np.array([o.width for o in objs]), predicted)
         return self._stance_partners(out, detection, world, legs, leg_scores, xy, groups, walking)
@@ -421,7 +422,7 @@ class PeopleTracker:
         s_xy = world.transform_points(leg_centres(legs.xy[still], widths, self.pairing.max_leg_radius_m))
         # a standing person's legs are theirs: the owner among everyone confirmed, walking or not
         everyone = [t for t in self._tracks if t.confirmed]
-        s_own = owners(s_xy, np.array([t.position for t in everyone]).reshape(-1, 2), self._half_stride_m)
+        s_own = owners(s_xy, np.array([t.position for t in everyone]).reshape(-1, 2), self.pairing.half_stride_m)
         index = {o.object_id: i for i, o in enumerate(detection.objects)}
         out = list(candidates)
         taken: set[int] = set()
@@ -499,7 +500,7 @@ class PeopleTracker:
         standing = [i for i, t in enumerate(ts) if t.confirmed and i not in taken_t and t.still]
         # the stepping leg lands within half a stride of them
         return pairs + self._recover_to(candidates, standing, [ts[i].position for i in standing], taken_c,
-                                        self._half_stride_m)
+                                        self.pairing.half_stride_m)
 
     def _lost_walkers(self, indices) -> list[int]:
         """Of the tracks at ``indices``, the confirmed walkers whose legs were last seen
@@ -665,11 +666,6 @@ class PeopleTracker:
                                                          self.assoc.start_leg_probability)
         self._spawn([c for ci, c in enumerate(candidates) if ci not in used and free[ci]], stamp)
 
-    @property
-    def _half_stride_m(self) -> float:
-        """``pairing.half_stride_m``, m."""
-        return self.pairing.half_stride_m
-
     def _duplicates(self) -> set[int]:
         """Indices of tracks that slid onto a person standing still who has a track already.
 
@@ -696,7 +692,7 @@ class PeopleTracker:
                 continue
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
-                passing = (np.hypot(*(walker.origin - stander.position)) > self._half_stride_m
+                passing = (np.hypot(*(walker.origin - stander.position)) > self.pairing.half_stride_m
                            and walker.stamp - walker.last_moving_update <= self.track_params.still_after_s
                            and np.hypot(*walker.velocity) >= PASSING_MPS)
                 if not passing:  # born at their leg (their own leg's track), or sliding onto them
@@ -800,9 +796,6 @@ def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:
     return pose.inverse().transform_points(np.array([(t.x, t.y) for t in tracks]))
 
 
-__all__ = ["AssociationParams", "PeopleTracker", "StepResult", "tracks_in_sensor_frame"]
-
-
 def warm_up_kernels(config=None) -> float:
     """Compile the compiled kernels (the first time on a machine, about half a minute) or
     load them from numba's cache (well under a second), by tracking four seconds of the
@@ -810,8 +803,6 @@ def warm_up_kernels(config=None) -> float:
     argument types the pipeline gives it. A live node calls it before it subscribes: left
     to the first scans, the loading would queue and drop them. Returns the seconds it took
     (0 without the kernels)."""
-    from people_tracker.models import compiled
-    from people_tracker.detection.free_space import place_visibility
     from people_tracker.models.scenario import build_simulation, load_scenario
     from people_tracker.tracker.config import load_config
 
@@ -829,3 +820,6 @@ def warm_up_kernels(config=None) -> float:
         place_visibility(np.array([[1.0, 0.5], [3.0, -1.0]]), last.scan, last.pose, config.existence.place_radius_m,
                          tracker.detector.params.no_return_free_m)
     return time.perf_counter() - t0
+
+
+__all__ = ["AssociationParams", "PeopleTracker", "StepResult", "tracks_in_sensor_frame", "warm_up_kernels"]

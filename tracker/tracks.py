@@ -213,17 +213,24 @@ class TrackState:
 
     def dead(self) -> bool:
         """Whether this track ends now: unlikely, lost, or tentative too long."""
+        return self.end_reason() is not None
+
+    def end_reason(self) -> str | None:
+        """Which rule ends this track now (None: none does): ``absence``, ``existence``,
+        ``tentative`` or ``uncertainty`` (see :meth:`dead`)."""
         p, e = self.params, self.existence
         # the evidence of absence alone ends any track, whatever its shape; the shape too
         # ends a confirmed one (a tentative track's shape is not known well yet)
-        if e.l_dyn <= logit(e.params.delete) or (self.confirmed and e.probability < e.params.delete):
-            return True
+        if e.l_dyn <= logit(e.params.delete):
+            return "absence"
+        if self.confirmed and e.probability < e.params.delete:
+            return "existence"
         if not self.confirmed and self.stamp - self.born > p.max_tentative_s:
-            return True
+            return "tentative"
         (a, b), (_, c) = self.position_cov
         # largest eigenvalue of the 2x2 covariance [[a, b], [b, c]]
         largest = 0.5 * (a + c) + math.sqrt(0.25 * (a - c) ** 2 + b * b)
-        return math.sqrt(max(largest, 0.0)) > p.max_position_std_m
+        return "uncertainty" if math.sqrt(max(largest, 0.0)) > p.max_position_std_m else None
 
     def furniture(self) -> bool:
         """Born standing, never moved, its place never seen empty, never confirmed: not a person."""

@@ -1,8 +1,8 @@
 """Opening recordings with rosbags and choosing topics, with one-line errors.
 
 Supports ROS 1 ``.bag`` files, ROS 2 bag folders (sqlite3 or MCAP storage; or their
-``metadata.yaml``) and bare ``.mcap`` / ``.db3`` files. Message definitions come from the recording itself; a ROS 2
-bag without them falls back to the standard ROS 2 types.
+``metadata.yaml``) and bare ``.mcap`` / ``.db3`` files. Message definitions come from the
+recording itself; a ROS 2 bag without them falls back to the standard ROS 2 types.
 """
 
 from __future__ import annotations
@@ -37,7 +37,8 @@ def open_bag(path: str | Path) -> AnyReader:
             raise InputError(f"input '{p}' is a folder but not a ROS 2 bag (it has no metadata.yaml)")
     else:
         if p.suffix not in (".bag", ".mcap", ".db3"):
-            raise InputError(f"input '{p}' is not a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), or an .mcap or .db3 file")
+            raise InputError(f"input '{p}' is not a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), "
+                             "or an .mcap or .db3 file")
         if p.stat().st_size == 0:
             raise InputError(f"input '{p}' is empty")
     kind = "ROS 1 bag" if p.suffix == ".bag" else "ROS 2 recording"
