@@ -82,6 +82,9 @@ class Walker:
     body: PersonModel = field(default_factory=PersonModel)
     round_radius: float | None = None  # set: a round object of this radius (m) instead of two legs
     step_phase_m: float = 0.0  # m: footprints lie at (k + ½)·step_length + this along the path
+    # where others make them step aside: (times s, shape (n,); offsets m, world frame, shape (n, 2)),
+    # added to the torso and both legs (see :func:`people_tracker.models.keep_apart.keep_apart`)
+    detour: tuple[np.ndarray, np.ndarray] | None = None
 
     def __post_init__(self) -> None:
         wp = np.asarray(self.waypoints, dtype=float).reshape(-1, 2)
@@ -151,6 +154,31 @@ class Walker:
         t0, s0, v = self._pieces[i]
         return float(min(s0 + v * (t - t0), self._s_end)), bool(v == 0.0)
 
+    def path_positions(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Torso on the path at each of ``times`` (s), before any detour: positions (n, 2) in
+        the world frame (m), unit walking directions (n, 2) and whether present, (n,)."""
+        t = np.asarray(times, dtype=float)
+        p = self._pieces
+        i = np.clip(np.searchsorted(p[:, 0], t, side="right") - 1, 0, len(p) - 1)
+        s = np.minimum(p[i, 1] + p[i, 2] * np.maximum(t - p[i, 0], 0.0), self._s_end)
+        s = np.where(t <= self.start_time, 0.0, np.where(t >= self.end_time, self._s_end, s))
+        last = len(self._seg_len) - 1
+        k = np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, last)
+        # a zero-length piece has no direction of its own: take the next one's, as _at does
+        nonzero = np.flatnonzero(self._seg_len > 0)
+        if len(nonzero):
+            k = nonzero[np.minimum(np.searchsorted(nonzero, k), len(nonzero) - 1)]
+        u = self._unit[k]
+        pos = self.waypoints[k] + u * (s - self._cum[k])[:, None]
+        present = (t >= self.start_time) & ~(self.exit_at_end & (t > self.end_time))
+        return pos, u, present
+
+    def _detour_at(self, t: float) -> np.ndarray | None:
+        if self.detour is None:
+            return None
+        times, off = self.detour
+        return np.array([np.interp(t, times, off[:, 0]), np.interp(t, times, off[:, 1])])
+
     def _at(self, s: float) -> tuple[np.ndarray, np.ndarray]:
         """Point and unit direction of the path at arc length ``s``."""
         cum = self._cum_list
@@ -164,7 +192,9 @@ class Walker:
 
     def torso(self, t: float) -> np.ndarray:
         """Torso position (the ground truth) at time ``t``, world frame, metres."""
-        return self._at(self.arc_length(t))[0]
+        p = self._at(self.arc_length(t))[0]
+        off = self._detour_at(t)
+        return p if off is None else p + off
 
     def _footprint(self, k: int) -> np.ndarray:
         p, u = self._at((k + 0.5) * self.body.step_length + self.step_phase_m)
@@ -180,6 +210,11 @@ class Walker:
 
     def legs(self, t: float) -> np.ndarray:
         """Centres of the two legs at time ``t``, shape (2, 2): row 0 the stance leg."""
+        off = self._detour_at(t)
+        legs = self._path_legs(t)
+        return legs if off is None else legs + off
+
+    def _path_legs(self, t: float) -> np.ndarray:
         L = self.body.step_length
         s, standing = self._walk(t)
         k = int(math.floor((s - self.step_phase_m) / L + 1e-9))

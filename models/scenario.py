@@ -23,6 +23,7 @@ file, radians inside)::
     visitors: {count, door: [x, y], area: [x0, y0, x1, y1], range_m: [lo, hi], stand_s: [lo, hi],
                arrive_every_s: [lo, hi], speed: [lo, hi], face_to_face: pairs, distance_m: [lo, hi]}
     furniture: {count, area: [x0, y0, x1, y1], range_m: [lo, hi], radius_m: [lo, hi], spacing_m: [lo, hi]}
+    keep_apart_m: 0.45        # m between torsos that crowd members and passers-by keep (0: none)
 
 ``visitors`` walk in from the door one after another, stand at a spot of their own in ``area``
 (``range_m`` from the sensor) for ``stand_s`` and walk out; ``face_to_face`` pairs of them
@@ -38,6 +39,10 @@ the other; ``oncoming`` ones walk the other way and pass ``offset_m`` beside the
 person with their true position (see :class:`~people_tracker.models.robot.FollowDriver`);
 ``odometry: false`` leaves odometry out of the recording.
 
+Crowd members and passers-by step aside rather than walk through anyone: each keeps
+``keep_apart_m`` between torsos from the people listed, the visitors and those of them drawn
+before (:func:`~people_tracker.models.keep_apart.keep_apart`; crowd members within their area).
+
 Every key is checked: an unknown one is an error that names it.
 """
 
@@ -51,6 +56,7 @@ import yaml
 
 from people_tracker.configs import names_a_file, shipped_file, shipped_names
 
+from people_tracker.models.keep_apart import GAP_M, keep_apart
 from people_tracker.models.laser import LaserModel
 from people_tracker.models.person import PersonModel, Walker
 from people_tracker.models.pose import Pose2D
@@ -63,9 +69,11 @@ class ScenarioError(ValueError):
     """A scenario that cannot be built; the message names the key."""
 
 
+CROWD_AREA = [0, -5, 10, 5]  # m, world frame: where a crowd wanders unless told
+
 _KEYS = {
     "": {"description", "duration_s", "seed", "laser", "lasers", "world", "robot", "people", "crowd", "visitors",
-         "furniture", "passers"},
+         "furniture", "passers", "keep_apart_m"},
     "laser": {"fov_deg", "resolution_deg", "rate_hz", "range_min", "range_max", "noise_std", "dropout",
               "dropout_value", "spurious", "clockwise", "frame_id", "sweep_fraction"},
     "world": {"room", "walls", "boxes", "pillars"},
@@ -227,7 +235,7 @@ def _crowd(spec: dict, first_id: int, rng: np.random.Generator, count: int | Non
     """
     w = "crowd."
     n = int(_num(spec, "count", 30, w, 0, 10000) if count is None else count)
-    x0, y0, x1, y1 = (float(a) for a in spec.get("area", [0, -5, 10, 5]))
+    x0, y0, x1, y1 = (float(a) for a in spec.get("area", CROWD_AREA))
     lo, hi = (float(a) for a in spec.get("speed", [0.4, 1.4]))
     n_wp = int(_num(spec, "waypoints", 8, w, 2, 1000))
     p_lo, p_hi = (float(a) for a in spec.get("pause_s", [1.0, 4.0]))
@@ -435,9 +443,11 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
                                 math.radians(_num(robot, "max_turn_degps", 60.0, "robot.", 0.0, 1000.0)))
     noise = robot.get("odometry_noise", {}) or {}
     walkers = [_walker(i, p, rng) for i, p in enumerate(spec.get("people", []) or [])]
+    crowd: list[Walker] = []
     if "crowd" in spec or crowd_count is not None:
-        walkers += _crowd(spec.get("crowd", {}) or {}, 1 + max([w.person_id for w in walkers], default=0), rng,
-                          crowd_count, _num(spec, "duration_s", 20.0, "", 0.0, 86400.0, lo_open=True), seed)
+        crowd = _crowd(spec.get("crowd", {}) or {}, 1 + max([w.person_id for w in walkers], default=0), rng,
+                       crowd_count, _num(spec, "duration_s", 20.0, "", 0.0, 86400.0, lo_open=True), seed)
+        walkers += crowd
     sensor = start.compose(mount)
     sensor_xy = np.array([sensor.x, sensor.y])
     furniture = _furniture(spec["furniture"] or {}, rng, sensor_xy) if "furniture" in spec else np.zeros((0, 3))
@@ -460,12 +470,20 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
                               math.radians(_num(f, "max_turn_degps", 1.0, "robot.follow.", 1.0, 1000.0))
                               if "max_turn_degps" in f else 1.5,
                               bool(f.get("trail", False)), _hold(f.get("hold")), _beside(f.get("beside")))
+    passers: list[Walker] = []
     for p in _as_list(spec.get("passers")):
         pid = p.get("person", target_id if target_id is not None else walkers[0].person_id if walkers else None)
         person = next((w for w in walkers if w.person_id == pid), None)
         if person is None:
             raise ScenarioError(f"scenario key 'passers.person': no person with id {pid!r}")
-        walkers += _passers(p, 1 + max(w.person_id for w in walkers), rng, person, duration)
+        group = _passers(p, 1 + max(w.person_id for w in walkers), rng, person, duration)
+        passers += group
+        walkers += group
+    yielding = crowd + passers
+    fixed = [w for w in walkers if not any(w is y for y in yielding)]
+    area = tuple(float(a) for a in (spec.get("crowd", {}) or {}).get("area", CROWD_AREA))
+    keep_apart(fixed, yielding, duration, _num(spec, "keep_apart_m", GAP_M, "", 0.0, 5.0),
+               bounds={w.person_id: area for w in crowd})
     sim = Simulation(laser, world, walkers, rng, mount=mount, start=start, driver=driver,
                      odom_trans_noise=_num(noise, "trans", 0.0, "robot.odometry_noise.", 0.0, 1.0),
                      odom_rot_noise=_num(noise, "rot", 0.0, "robot.odometry_noise.", 0.0, 1.0),

@@ -62,3 +62,44 @@ def test_the_waiting_room_keeps_its_promises(seed):
     assert ((r >= 1.7) & (r <= 6.3)).all()
     standing_at = np.array([s[0] for s in spots])
     assert (np.hypot(*(legs[:, None, :2] - standing_at[None]).T).min(axis=0) < 3.0).mean() > 0.5
+
+
+def _closest_pairs(walkers, times):
+    """Seconds (at the step of ``times``) two present people spend closer than 0.30 m and
+    0.40 m, torso to torso."""
+    pos = np.stack([[w.torso(t) for t in times] for w in walkers])  # (people, times, 2)
+    present = np.array([[w.present(t) for t in times] for w in walkers])
+    dt = times[1] - times[0]
+    below = {0.30: 0.0, 0.40: 0.0}
+    for a in range(len(walkers)):
+        d = np.hypot(*(pos[a + 1:] - pos[a]).transpose(2, 0, 1))
+        d[~(present[a + 1:] & present[a])] = np.inf
+        for gap in below:
+            below[gap] += float((d < gap).sum()) * dt
+    return below
+
+
+@pytest.mark.parametrize("name, seconds", [("crowd", 30.0), ("follow_indoor_crowd", 120.0)])
+def test_people_step_aside_rather_than_walk_through_each_other(name, seconds):
+    spec = {**load_scenario(name), "duration_s": seconds}
+    times = np.arange(0.0, seconds, 0.1)
+    sim, _ = build_simulation(spec)
+    apart = _closest_pairs(sim.walkers, times)
+    through, _ = build_simulation({**spec, "keep_apart_m": 0})  # the same paths, nobody stepping aside
+    close = _closest_pairs(through.walkers, times)
+    assert close[0.30] > 5.0, close  # without it people overlap for seconds
+    # with it hardly ever: a walker squeezed between several, or by the crowd's edge, may still be
+    assert apart[0.30] < 0.1 * close[0.30] and apart[0.40] < 0.1 * close[0.40], (apart, close)
+    if name == "follow_indoor_crowd":  # and never through the followed person
+        person = next(w for w in sim.walkers if w.person_id == sim.target_id)
+        others = [w for w in sim.walkers if w is not person]
+        assert all(np.hypot(*(w.torso(t) - person.torso(t))) >= 0.30
+                   for w in others for t in times if w.present(t))
+    # only a step aside: everyone stays within a metre of their path, in the crowd's area
+    for w in sim.walkers:
+        if w.detour is not None:
+            assert np.hypot(*w.detour[1].T).max() <= 1.0 + 1e-9
+    x0, y0, x1, y1 = spec["crowd"]["area"]
+    crowd = [w for w in sim.walkers if w.detour is not None and not w.exit_at_end]
+    assert crowd and all(x0 - 1e-9 <= w.torso(t)[0] <= x1 + 1e-9 and y0 - 1e-9 <= w.torso(t)[1] <= y1 + 1e-9
+                         for w in crowd for t in times)
