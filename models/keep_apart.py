@@ -54,7 +54,8 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
             if offsets is not None:
                 w.detour = (times, offsets)
                 base = base + offsets
-        placed_pos.append(base), placed_present.append(present)
+        placed_pos.append(base)
+        placed_present.append(present)
 
 
 def _offsets(w: Walker, times: np.ndarray) -> np.ndarray:
