@@ -2,15 +2,16 @@
 
 Crowd members and passers-by follow random or scripted paths drawn without regard for anyone
 else, so left alone two of them (or one of them and the followed person) would pass through
-each other, their legs overlapping, which no real pair of bodies does. :func:`keep_apart`
-gives each such walker a *detour*: a sideways offset from their path, in the world frame,
-that keeps their torso at least ``gap_m`` from everyone placed before them. They start to
-step aside ``lookahead_s`` before they would come too close, at no more than
-``sidestep_mps`` across their walking direction (to the right when the meeting is head-on),
-and drift back to their path at ``return_mps`` once clear. ``bounds`` (an area they stay in,
-such as the crowd's) can stop a detour short, so a pair may still come closer than
-``gap_m`` where a wall leaves no room; the walkers placed first (scripted people, visitors)
-never step aside.
+each other, their legs overlapping, which no real pair of bodies does; and through pillars
+and trees. :func:`keep_apart` gives each such walker a *detour*: a sideways offset from
+their path, in the world frame, that keeps their torso at least ``gap_m`` from everyone
+placed before them, and ``gap_m / 2`` (about a body's half width) from the edge of round
+obstacles (pillars, trees, table legs). They start to step aside ``lookahead_s`` before
+they would come too close, at no more than ``sidestep_mps`` across their walking direction
+(to the right when the meeting is head-on), and drift back to their path at ``return_mps``
+once clear. ``bounds`` (an area they stay in, such as the crowd's) can stop a detour short,
+so a pair may still come closer than ``gap_m`` where a wall leaves no room; the walkers
+placed first (scripted people, visitors) never step aside.
 
 Units: metres, seconds, world frame.
 """
@@ -30,32 +31,41 @@ GAP_M = 0.45
 
 def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, gap_m: float = GAP_M,
                dt_s: float = 0.1, lookahead_s: float = 1.0, sidestep_mps: float = 0.8, return_mps: float = 0.3,
-               bounds: dict[int, tuple[float, float, float, float]] | None = None) -> None:
+               bounds: dict[int, tuple[float, float, float, float]] | None = None,
+               obstacles: np.ndarray | None = None) -> None:
     """Set ``detour`` on each of ``yielding`` (in order) so they keep ``gap_m`` from ``fixed``
-    and from the yielding walkers before them. ``bounds`` maps a walker's ``person_id`` to an
-    area ``(x0, y0, x1, y1)`` their torso stays in. Walkers are changed in place."""
+    and from the yielding walkers before them, and half of it from the edge of each round
+    obstacle in ``obstacles`` (x, y, radius; m, world frame: pillars, trees, table legs).
+    ``bounds`` maps a walker's ``person_id`` to an area ``(x0, y0, x1, y1)`` their torso stays
+    in. Walkers are changed in place."""
     if gap_m <= 0 or not yielding:
         return
     times = np.arange(0.0, duration_s + dt_s, dt_s)
     ahead = max(1, int(round(lookahead_s / dt_s)))
     horizons = sorted({0, ahead // 2, ahead})
-    placed_pos, placed_present = [], []
+    placed_pos, placed_present, placed_gap = [], [], []
+    for x, y, r in np.asarray(obstacles if obstacles is not None else np.zeros((0, 3)), dtype=float).reshape(-1, 3):
+        placed_pos.append(np.broadcast_to(np.array([x, y]), (len(times), 2)))
+        placed_present.append(np.ones(len(times), dtype=bool))
+        placed_gap.append(r + 0.5 * gap_m)
     for w in fixed:
         pos, _, present = w.path_positions(times)
         placed_pos.append(pos if w.detour is None else pos + _offsets(w, times))
         placed_present.append(present)
+        placed_gap.append(gap_m)
     bounds = bounds or {}
     for w in yielding:
         base, heading, present = w.path_positions(times)
         if placed_pos:
             offsets = _sidesteps(base, heading, np.stack(placed_pos), np.stack(placed_present) & present[None, :],
-                                 horizons, gap_m, sidestep_mps * dt_s, return_mps * dt_s, bounds.get(w.person_id),
-                                 dt_s)
+                                 np.array(placed_gap), horizons, sidestep_mps * dt_s, return_mps * dt_s,
+                                 bounds.get(w.person_id), dt_s)
             if offsets is not None:
                 w.detour = (times, offsets)
                 base = base + offsets
         placed_pos.append(base)
         placed_present.append(present)
+        placed_gap.append(gap_m)
 
 
 def _offsets(w: Walker, times: np.ndarray) -> np.ndarray:
@@ -69,18 +79,18 @@ _MOST_M = 1.0
 _REACH_M = _MOST_M + 0.5
 
 
-def _sidesteps(base, heading, others, others_present, horizons, gap_m, step_m, back_m, box, dt_s):
+def _sidesteps(base, heading, others, others_present, gaps, horizons, step_m, back_m, box, dt_s):
     """The offset (n, 2) from the path, world frame, metres, time step by time step, or None
     when nobody comes near.
 
     Each step looks at where this walker and the others will be ``horizons`` steps ahead and
     steps aside across their motion relative to the other (out of the other's way), enough
-    to clear the closest of them by ``gap_m``. Plain floats: a step meets zero to three
+    to clear each of them by their ``gaps`` (m, one per other). Plain floats: a step meets zero to three
     people, too few for array calls to pay."""
     n = len(base)
     last = n - 1
     dist = np.hypot(others[..., 0] - base[None, :, 0], others[..., 1] - base[None, :, 1])
-    close = others_present & (dist < gap_m + _REACH_M)  # (m, n)
+    close = others_present & (dist < gaps[:, None] + _REACH_M)  # (m, n)
     if not close.any():
         return None
     own_v = np.gradient(base, dt_s, axis=0) if n > 1 else np.zeros_like(base)
@@ -92,7 +102,7 @@ def _sidesteps(base, heading, others, others_present, horizons, gap_m, step_m, b
         j_of = np.minimum(np.arange(n) + h, last)
         when, who = np.nonzero(close[:, j_of].T)  # sorted by step
         j = j_of[when]
-        where[h] = (others[who, j, 0].tolist(), others[who, j, 1].tolist())
+        where[h] = (others[who, j, 0].tolist(), others[who, j, 1].tolist(), gaps[who].tolist())
         moving[h] = (others_v[who, j, 0].tolist(), others_v[who, j, 1].tolist())
         steps, first = np.unique(when, return_index=True)
         ends = np.append(first[1:], len(when))
@@ -101,7 +111,6 @@ def _sidesteps(base, heading, others, others_present, horizons, gap_m, step_m, b
     bx, by = base[:, 0].tolist(), base[:, 1].tolist()
     hx, hy = heading[:, 0].tolist(), heading[:, 1].tolist()
     vx, vy = own_v[:, 0].tolist(), own_v[:, 1].tolist()
-    gap2 = gap_m * gap_m
     offsets = np.zeros((n, 2))
     ox = oy = 0.0
     order = horizons[::-1] * 4
@@ -118,21 +127,22 @@ def _sidesteps(base, heading, others, others_present, horizons, gap_m, step_m, b
             if span is None:
                 continue
             j = min(k + h, last)
-            px, py = where[h]
+            px, py, pg = where[h]
             qx, qy = moving[h]
             sx = sy = 0.0
             for i in range(*span):
+                gap = pg[i]
                 dx, dy = bx[j] + gx - px[i], by[j] + gy - py[i]  # from them to this walker
                 rx, ry = vx[j] - qx[i], vy[j] - qy[i]
                 speed = math.hypot(rx, ry)
                 if speed > 0.05:  # out of their way, across the motion relative to them
                     ux, uy = rx / speed, ry / speed
                     along = dx * ux + dy * uy
-                    if abs(along) >= gap_m:
+                    if abs(along) >= gap:
                         continue
                     ax, ay = -uy, ux
                     across = dx * ax + dy * ay
-                    need = math.sqrt(gap2 - along * along) - abs(across)
+                    need = math.sqrt(gap * gap - along * along) - abs(across)
                     if need > 0:
                         if abs(across) > 1e-3:
                             side = 1.0 if across > 0 else -1.0
@@ -142,7 +152,7 @@ def _sidesteps(base, heading, others, others_present, horizons, gap_m, step_m, b
                         sy += need * side * ay
                 else:  # both standing, or walking side by side: straight apart
                     apart = math.hypot(dx, dy)
-                    need = gap_m - apart
+                    need = gap - apart
                     if need > 0:
                         ux, uy = (dx / apart, dy / apart) if apart > 1e-6 else (-hy[j], hx[j])
                         sx += need * ux

@@ -41,7 +41,8 @@ person with their true position (see :class:`~people_tracker.models.robot.Follow
 
 Crowd members and passers-by step aside rather than walk through anyone: each keeps
 ``keep_apart_m`` between torsos from the people listed, the visitors and those of them drawn
-before (:func:`~people_tracker.models.keep_apart.keep_apart`; crowd members within their area).
+before, and half of it from pillars, trees and furniture legs
+(:func:`~people_tracker.models.keep_apart.keep_apart`; crowd members within their area).
 
 Every key is checked: an unknown one is an error that names it.
 """
@@ -483,7 +484,7 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
     fixed = [w for w in walkers if not any(w is y for y in yielding)]
     area = tuple(float(a) for a in (spec.get("crowd", {}) or {}).get("area", CROWD_AREA))
     keep_apart(fixed, yielding, duration, _num(spec, "keep_apart_m", GAP_M, "", 0.0, 5.0),
-               bounds={w.person_id: area for w in crowd})
+               bounds={w.person_id: area for w in crowd}, obstacles=world.circles)
     sim = Simulation(laser, world, walkers, rng, mount=mount, start=start, driver=driver,
                      odom_trans_noise=_num(noise, "trans", 0.0, "robot.odometry_noise.", 0.0, 1.0),
                      odom_rot_noise=_num(noise, "rot", 0.0, "robot.odometry_noise.", 0.0, 1.0),
