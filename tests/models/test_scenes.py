@@ -103,3 +103,27 @@ def test_people_step_aside_rather_than_walk_through_each_other(name, seconds):
     crowd = [w for w in sim.walkers if w.detour is not None and not w.exit_at_end]
     assert crowd and all(x0 - 1e-9 <= w.torso(t)[0] <= x1 + 1e-9 and y0 - 1e-9 <= w.torso(t)[1] <= y1 + 1e-9
                          for w in crowd for t in times)
+
+
+def _seconds_at_obstacles(sim, times, within_m):
+    """Seconds the crowd's torsos spend within ``within_m`` of a pillar's edge (m), and the
+    deepest they go (negative: inside it)."""
+    seconds, closest = 0.0, np.inf
+    for w in sim.walkers:
+        pos = np.array([w.torso(t) for t in times])
+        for x, y, r in sim.world.circles:
+            edge = np.hypot(pos[:, 0] - x, pos[:, 1] - y) - r
+            seconds += float((edge < within_m).sum()) * (times[1] - times[0])
+            closest = min(closest, float(edge.min()))
+    return seconds, closest
+
+
+def test_the_crowd_walks_round_the_pillars():
+    spec = load_scenario("crowd")
+    times = np.arange(0.0, spec["duration_s"], 0.1)
+    sim, _ = build_simulation(spec)
+    through, _ = build_simulation({**spec, "keep_apart_m": 0})
+    before, deepest = _seconds_at_obstacles(through, times, 0.15)
+    after, closest = _seconds_at_obstacles(sim, times, 0.15)
+    assert before > 5.0 and deepest < 0.0, (before, deepest)  # the paths go through the pillars
+    assert after < 0.1 * before and closest > 0.0, (after, closest)  # nobody walks into one now
