@@ -75,7 +75,7 @@ def _offsets(w: Walker, times: np.ndarray) -> np.ndarray:
 
 #: metres: the farthest a detour takes a walker from their path
 _MOST_M = 1.0
-#: metres: how far beyond ``gap_m`` to look for people who may need avoiding
+#: metres: how far beyond their gap to look for people and obstacles that may need avoiding
 _REACH_M = _MOST_M + 0.5
 
 
@@ -85,8 +85,8 @@ def _sidesteps(base, heading, others, others_present, gaps, horizons, step_m, ba
 
     Each step looks at where this walker and the others will be ``horizons`` steps ahead and
     steps aside across their motion relative to the other (out of the other's way), enough
-    to clear each of them by their ``gaps`` (m, one per other). Plain floats: a step meets zero to three
-    people, too few for array calls to pay."""
+    to clear each of them by their ``gaps`` (m, one per other). Plain floats: a step meets
+    zero to three people, too few for array calls to pay."""
     n = len(base)
     last = n - 1
     dist = np.hypot(others[..., 0] - base[None, :, 0], others[..., 1] - base[None, :, 1])
