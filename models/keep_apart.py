@@ -48,9 +48,9 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
         placed_pos.append(np.broadcast_to(np.array([x, y]), (len(times), 2)))
         placed_present.append(np.ones(len(times), dtype=bool))
         placed_gap.append(r + 0.5 * gap_m)
-    for w in fixed:
+    for w in fixed:  # they keep to their paths
         pos, _, present = w.path_positions(times)
-        placed_pos.append(pos if w.detour is None else pos + _offsets(w, times))
+        placed_pos.append(pos)
         placed_present.append(present)
         placed_gap.append(gap_m)
     bounds = bounds or {}
@@ -66,11 +66,6 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
         placed_pos.append(base)
         placed_present.append(present)
         placed_gap.append(gap_m)
-
-
-def _offsets(w: Walker, times: np.ndarray) -> np.ndarray:
-    t, off = w.detour
-    return np.column_stack([np.interp(times, t, off[:, 0]), np.interp(times, t, off[:, 1])])
 
 
 #: metres: the farthest a detour takes a walker from their path

@@ -236,7 +236,7 @@ def _crowd(spec: dict, first_id: int, rng: np.random.Generator, count: int | Non
     """
     w = "crowd."
     n = int(_num(spec, "count", 30, w, 0, 10000) if count is None else count)
-    x0, y0, x1, y1 = (float(a) for a in spec.get("area", CROWD_AREA))
+    x0, y0, x1, y1 = _crowd_area(spec)
     lo, hi = (float(a) for a in spec.get("speed", [0.4, 1.4]))
     n_wp = int(_num(spec, "waypoints", 8, w, 2, 1000))
     p_lo, p_hi = (float(a) for a in spec.get("pause_s", [1.0, 4.0]))
@@ -258,6 +258,12 @@ def _crowd(spec: dict, first_id: int, rng: np.random.Generator, count: int | Non
             points.append(nxt)
         out.append(Walker(first_id + k, np.array(points), speed, pauses, 0.0, False, PersonModel.sample(rng, speed)))
     return out
+
+
+def _crowd_area(spec: dict) -> tuple[float, float, float, float]:
+    """Where a crowd wanders, ``(x0, y0, x1, y1)``, m, world frame."""
+    x0, y0, x1, y1 = (float(a) for a in spec.get("area", CROWD_AREA))
+    return x0, y0, x1, y1
 
 
 def _interval(d: dict, key: str, default: list[float], where: str, lo: float = 0.0) -> tuple[float, float]:
@@ -481,8 +487,9 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
         passers += group
         walkers += group
     yielding = crowd + passers
-    fixed = [w for w in walkers if not any(w is y for y in yielding)]
-    area = tuple(float(a) for a in (spec.get("crowd", {}) or {}).get("area", CROWD_AREA))
+    moved = {id(w) for w in yielding}
+    fixed = [w for w in walkers if id(w) not in moved]  # the people listed and the visitors
+    area = _crowd_area(spec.get("crowd", {}) or {})
     keep_apart(fixed, yielding, duration, _num(spec, "keep_apart_m", GAP_M, "", 0.0, 5.0),
                bounds={w.person_id: area for w in crowd}, obstacles=world.circles)
     sim = Simulation(laser, world, walkers, rng, mount=mount, start=start, driver=driver,

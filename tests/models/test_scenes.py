@@ -127,3 +127,14 @@ def test_the_crowd_walks_round_the_pillars():
     after, closest = _seconds_at_obstacles(sim, times, 0.15)
     assert before > 5.0 and deepest < 0.0, (before, deepest)  # the paths go through the pillars
     assert after < 0.1 * before and closest > 0.0, (after, closest)  # nobody walks into one now
+
+
+def test_the_paths_worked_out_at_once_are_the_walkers_own():
+    # keep_apart reads every walker's path for the whole scene at once (path_positions);
+    # it must be where torso() puts them, pauses, turns and zero-length pieces included
+    sim, _ = build_simulation({**load_scenario("follow_indoor_crowd"), "keep_apart_m": 0, "duration_s": 120})
+    times = np.arange(-1.0, 121.0, 0.37)
+    for w in sim.walkers:
+        pos, _, present = w.path_positions(times)
+        assert np.allclose(pos, [w.torso(t) for t in times], atol=1e-9)
+        assert list(present) == [w.present(t) for t in times]
