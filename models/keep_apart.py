@@ -43,42 +43,54 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
     times = np.arange(0.0, duration_s + dt_s, dt_s)
     ahead = max(1, int(round(lookahead_s / dt_s)))
     horizons = sorted({0, ahead // 2, ahead})
-    placed_pos, placed_present, placed_gap = [], [], []
-    for x, y, r in np.asarray(obstacles if obstacles is not None else np.zeros((0, 3)), dtype=float).reshape(-1, 3):
-        placed_pos.append(np.broadcast_to(np.array([x, y]), (len(times), 2)))
-        placed_present.append(np.ones(len(times), dtype=bool))
-        placed_gap.append(r + 0.5 * gap_m)
+    obstacles = np.asarray(obstacles if obstacles is not None else np.zeros((0, 3)), dtype=float).reshape(-1, 3)
+    # everyone placed so far, row by row: torso or obstacle centre (m) and velocity (m/s),
+    # world frame, at each time; whether there; the gap to keep from them (m). Filled in
+    # place, so that an hour's scene does not copy them all again for each walker
+    rows = len(obstacles) + len(fixed) + len(yielding)
+    pos, vel = np.zeros((rows, len(times), 2)), np.zeros((rows, len(times), 2))
+    there, gaps = np.zeros((rows, len(times)), dtype=bool), np.zeros(rows)
+    pos[:len(obstacles)] = obstacles[:, None, :2]
+    there[:len(obstacles)] = True
+    gaps[:len(obstacles)] = obstacles[:, 2] + 0.5 * gap_m
+    m = len(obstacles)
+
+    def place(where: np.ndarray, present: np.ndarray) -> None:
+        nonlocal m
+        pos[m], there[m], gaps[m] = where, present, gap_m
+        vel[m] = np.gradient(where, dt_s, axis=0) if len(times) > 1 else 0.0
+        m += 1
+
     for w in fixed:  # they keep to their paths
-        pos, _, present = w.path_positions(times)
-        placed_pos.append(pos)
-        placed_present.append(present)
-        placed_gap.append(gap_m)
+        where, _, present = w.path_positions(times)
+        place(where, present)
     bounds = bounds or {}
     for w in yielding:
         base, heading, present = w.path_positions(times)
-        if placed_pos:
-            offsets = _sidesteps(base, heading, np.stack(placed_pos), np.stack(placed_present) & present[None, :],
-                                 np.array(placed_gap), horizons, sidestep_mps * dt_s, return_mps * dt_s,
-                                 bounds.get(w.person_id), dt_s)
+        if m:
+            offsets = _sidesteps(base, heading, pos[:m], vel[:m], there[:m] & present[None, :], gaps[:m],
+                                 horizons, sidestep_mps * dt_s, return_mps * dt_s, bounds.get(w.person_id), dt_s)
             if offsets is not None:
                 w.detour = (times, offsets)
                 base = base + offsets
-        placed_pos.append(base)
-        placed_present.append(present)
-        placed_gap.append(gap_m)
+        place(base, present)
 
 
 #: metres: the farthest a detour takes a walker from their path
 _MOST_M = 1.0
 #: metres: how far beyond their gap to look for people and obstacles that may need avoiding
 _REACH_M = _MOST_M + 0.5
+#: time steps whose tables of who is close are built at once (a minute at 0.1 s)
+_CHUNK_STEPS = 600
 
 
-def _sidesteps(base, heading, others, others_present, gaps, horizons, step_m, back_m, box, dt_s):
+def _sidesteps(base, heading, others, others_v, others_present, gaps, horizons, step_m, back_m, box, dt_s):
     """The offset (n, 2) from the path, world frame, metres, time step by time step, or None
     when nobody comes near.
 
-    Each step looks at where this walker and the others will be ``horizons`` steps ahead and
+    ``others`` and ``others_v`` (m, n, 2) are the others' places (m) and velocities (m/s),
+    ``others_present`` (m, n) whether each is there with this walker. Each step looks at
+    where this walker and the others will be ``horizons`` steps ahead and
     steps aside across their motion relative to the other (out of the other's way), enough
     to clear each of them by their ``gaps`` (m, one per other). Plain floats: a step meets
     zero to three people, too few for array calls to pay."""
@@ -89,80 +101,90 @@ def _sidesteps(base, heading, others, others_present, gaps, horizons, step_m, ba
     if not close.any():
         return None
     own_v = np.gradient(base, dt_s, axis=0) if n > 1 else np.zeros_like(base)
-    others_v = np.gradient(others, dt_s, axis=1) if n > 1 else np.zeros_like(others)
-    # who is close at each step k, h steps ahead: near[h][k] is the range of them in the
-    # h-th lists of their positions and velocities (m, m/s, world frame) at step k + h
-    near, where, moving = {}, {}, {}
-    for h in horizons:
-        j_of = np.minimum(np.arange(n) + h, last)
-        when, who = np.nonzero(close[:, j_of].T)  # sorted by step
-        j = j_of[when]
-        where[h] = (others[who, j, 0].tolist(), others[who, j, 1].tolist(), gaps[who].tolist())
-        moving[h] = (others_v[who, j, 0].tolist(), others_v[who, j, 1].tolist())
-        steps, first = np.unique(when, return_index=True)
-        ends = np.append(first[1:], len(when))
-        near[h] = dict(zip(steps.tolist(), zip(first.tolist(), ends.tolist())))
-    busy = set().union(*(t.keys() for t in near.values()))
     bx, by = base[:, 0].tolist(), base[:, 1].tolist()
     hx, hy = heading[:, 0].tolist(), heading[:, 1].tolist()
     vx, vy = own_v[:, 0].tolist(), own_v[:, 1].tolist()
     offsets = np.zeros((n, 2))
     ox = oy = 0.0
     order = horizons[::-1] * 4
-    for k in range(n):
-        if k not in busy and ox == 0.0 and oy == 0.0:
-            continue
-        size = math.hypot(ox, oy)  # drift back to the path
-        keep = max(0.0, 1.0 - back_m / size) if size > 0 else 0.0
-        gx, gy = ox * keep, oy * keep
-        # the farthest look first, so what is closest in time has the last word; again, so a
-        # step aside for one does not leave the walker on another
-        for h in order:
-            span = near[h].get(k)
-            if span is None:
+    for k0 in range(0, n, _CHUNK_STEPS):  # the tables of who is close, a chunk of steps at a time
+        k1 = min(k0 + _CHUNK_STEPS, n)
+        near, where, moving = _close_tables(k0, k1, close, others, others_v, gaps, horizons)
+        busy = set().union(*(t.keys() for t in near.values()))
+        for k in range(k0, k1):
+            if k not in busy and ox == 0.0 and oy == 0.0:
                 continue
-            j = min(k + h, last)
-            px, py, pg = where[h]
-            qx, qy = moving[h]
-            sx = sy = 0.0
-            for i in range(*span):
-                gap = pg[i]
-                dx, dy = bx[j] + gx - px[i], by[j] + gy - py[i]  # from them to this walker
-                rx, ry = vx[j] - qx[i], vy[j] - qy[i]
-                speed = math.hypot(rx, ry)
-                if speed > 0.05:  # out of their way, across the motion relative to them
-                    ux, uy = rx / speed, ry / speed
-                    along = dx * ux + dy * uy
-                    if abs(along) >= gap:
-                        continue
-                    ax, ay = -uy, ux
-                    across = dx * ax + dy * ay
-                    need = math.sqrt(gap * gap - along * along) - abs(across)
-                    if need > 0:
-                        if abs(across) > 1e-3:
-                            side = 1.0 if across > 0 else -1.0
-                        else:  # head-on: to the right of this walker's own heading
-                            side = -1.0 if ax * -hy[j] + ay * hx[j] > 0 else 1.0
-                        sx += need * side * ax
-                        sy += need * side * ay
-                else:  # both standing, or walking side by side: straight apart
-                    apart = math.hypot(dx, dy)
-                    need = gap - apart
-                    if need > 0:
-                        ux, uy = (dx / apart, dy / apart) if apart > 1e-6 else (-hy[j], hx[j])
-                        sx += need * ux
-                        sy += need * uy
-            gx, gy = gx + sx, gy + sy
-        cx, cy = gx - ox, gy - oy
-        size = math.hypot(cx, cy)
-        if size > step_m:
-            cx, cy = cx * step_m / size, cy * step_m / size
-        ox, oy = ox + cx, oy + cy
-        size = math.hypot(ox, oy)
-        if size > _MOST_M:
-            ox, oy = ox * _MOST_M / size, oy * _MOST_M / size
-        if box is not None:
-            ox = min(max(bx[k] + ox, box[0]), box[2]) - bx[k]
-            oy = min(max(by[k] + oy, box[1]), box[3]) - by[k]
-        offsets[k] = ox, oy
+            size = math.hypot(ox, oy)  # drift back to the path
+            keep = max(0.0, 1.0 - back_m / size) if size > 0 else 0.0
+            gx, gy = ox * keep, oy * keep
+            # the farthest look first, so what is closest in time has the last word; again, so a
+            # step aside for one does not leave the walker on another
+            for h in order:
+                span = near[h].get(k)
+                if span is None:
+                    continue
+                j = min(k + h, last)
+                px, py, pg = where[h]
+                qx, qy = moving[h]
+                sx = sy = 0.0
+                for i in range(*span):
+                    gap = pg[i]
+                    dx, dy = bx[j] + gx - px[i], by[j] + gy - py[i]  # from them to this walker
+                    rx, ry = vx[j] - qx[i], vy[j] - qy[i]
+                    speed = math.hypot(rx, ry)
+                    if speed > 0.05:  # out of their way, across the motion relative to them
+                        ux, uy = rx / speed, ry / speed
+                        along = dx * ux + dy * uy
+                        if abs(along) >= gap:
+                            continue
+                        ax, ay = -uy, ux
+                        across = dx * ax + dy * ay
+                        need = math.sqrt(gap * gap - along * along) - abs(across)
+                        if need > 0:
+                            if abs(across) > 1e-3:
+                                side = 1.0 if across > 0 else -1.0
+                            else:  # head-on: to the right of this walker's own heading
+                                side = -1.0 if ax * -hy[j] + ay * hx[j] > 0 else 1.0
+                            sx += need * side * ax
+                            sy += need * side * ay
+                    else:  # both standing, or walking side by side: straight apart
+                        apart = math.hypot(dx, dy)
+                        need = gap - apart
+                        if need > 0:
+                            ux, uy = (dx / apart, dy / apart) if apart > 1e-6 else (-hy[j], hx[j])
+                            sx += need * ux
+                            sy += need * uy
+                gx, gy = gx + sx, gy + sy
+            cx, cy = gx - ox, gy - oy
+            size = math.hypot(cx, cy)
+            if size > step_m:
+                cx, cy = cx * step_m / size, cy * step_m / size
+            ox, oy = ox + cx, oy + cy
+            size = math.hypot(ox, oy)
+            if size > _MOST_M:
+                ox, oy = ox * _MOST_M / size, oy * _MOST_M / size
+            if box is not None:
+                ox = min(max(bx[k] + ox, box[0]), box[2]) - bx[k]
+                oy = min(max(by[k] + oy, box[1]), box[3]) - by[k]
+            offsets[k] = ox, oy
     return offsets if offsets.any() else None
+
+
+def _close_tables(k0, k1, close, others, others_v, gaps, horizons):
+    """Who is close at each step k of ``k0``..``k1`` - 1, h steps ahead, for each h of
+    ``horizons``: ``near[h][k]`` is the range of them in the h-th lists of their positions
+    and gaps (m) and velocities (m/s, world frame) at step k + h. Plain lists, which the
+    step-by-step loop reads fastest; built a chunk at a time, as an hour's would hold
+    millions of floats."""
+    last = close.shape[1] - 1
+    near, where, moving = {}, {}, {}
+    for h in horizons:
+        j_of = np.minimum(np.arange(k0, k1) + h, last)
+        when, who = np.nonzero(close[:, j_of].T)  # sorted by step
+        j = j_of[when]
+        where[h] = (others[who, j, 0].tolist(), others[who, j, 1].tolist(), gaps[who].tolist())
+        moving[h] = (others_v[who, j, 0].tolist(), others_v[who, j, 1].tolist())
+        steps, first = np.unique(when + k0, return_index=True)
+        ends = np.append(first[1:], len(when))
+        near[h] = dict(zip(steps.tolist(), zip(first.tolist(), ends.tolist())))
+    return near, where, moving
