@@ -32,13 +32,17 @@ GAP_M = 0.45
 def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, gap_m: float = GAP_M,
                dt_s: float = 0.1, lookahead_s: float = 1.0, sidestep_mps: float = 0.8, return_mps: float = 0.3,
                bounds: dict[int, tuple[float, float, float, float]] | None = None,
-               obstacles: np.ndarray | None = None) -> None:
-    """Set ``detour`` on each of ``yielding`` (in order) so they keep ``gap_m`` from ``fixed``
-    and from the yielding walkers before them, and half of it from the edge of each round
-    obstacle in ``obstacles`` (x, y, radius; m, world frame: pillars, trees, table legs).
-    ``bounds`` maps a walker's ``person_id`` to an area ``(x0, y0, x1, y1)`` their torso stays
-    in. Walkers are changed in place."""
-    if gap_m <= 0 or not yielding:
+               obstacles: np.ndarray | None = None, visitors: list[Walker] | None = None) -> None:
+    """Set ``detour`` on each of ``yielding`` (in order) so they keep ``gap_m`` from ``fixed``,
+    from ``visitors`` and from the yielding walkers before them, and half of it from the edge
+    of each round obstacle in ``obstacles`` (x, y, radius; m, world frame: pillars, trees,
+    table legs). ``visitors`` (people who walk to a place, stand there a while and leave, as
+    in a waiting room) step aside for everyone but the yielding, before them in the list or
+    after, while they walk, and hold their place while they stand: whoever walks past
+    someone standing makes way. ``bounds`` maps a walker's ``person_id`` to an area
+    ``(x0, y0, x1, y1)`` their torso stays in. Walkers are changed in place."""
+    visitors, bounds = list(visitors or []), bounds or {}
+    if gap_m <= 0 or not (yielding or visitors):
         return
     times = np.arange(0.0, duration_s + dt_s, dt_s)
     ahead = max(1, int(round(lookahead_s / dt_s)))
@@ -47,7 +51,7 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
     # everyone placed so far, row by row: torso or obstacle centre (m) and velocity (m/s),
     # world frame, at each time; whether there; the gap to keep from them (m). Filled in
     # place, so that an hour's scene does not copy them all again for each walker
-    rows = len(obstacles) + len(fixed) + len(yielding)
+    rows = len(obstacles) + len(fixed) + len(visitors) + len(yielding)
     pos, vel = np.zeros((rows, len(times), 2)), np.zeros((rows, len(times), 2))
     there, gaps = np.zeros((rows, len(times)), dtype=bool), np.zeros(rows)
     pos[:len(obstacles)] = obstacles[:, None, :2]
@@ -55,25 +59,40 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
     gaps[:len(obstacles)] = obstacles[:, 2] + 0.5 * gap_m
     m = len(obstacles)
 
-    def place(where: np.ndarray, present: np.ndarray) -> None:
-        nonlocal m
-        pos[m], there[m], gaps[m] = where, present, gap_m
-        vel[m] = np.gradient(where, dt_s, axis=0) if len(times) > 1 else 0.0
-        m += 1
+    def place(row: int, where: np.ndarray, present: np.ndarray) -> None:
+        pos[row], there[row], gaps[row] = where, present, gap_m
+        vel[row] = np.gradient(where, dt_s, axis=0) if len(times) > 1 else 0.0
+
+    def detour(w: Walker, base: np.ndarray, heading: np.ndarray, present: np.ndarray, upto: int,
+               hold: np.ndarray | None = None) -> np.ndarray:
+        """``w``'s path with the detour that keeps them clear of rows ``:upto`` (set on them)."""
+        if upto:
+            offsets = _sidesteps(base, heading, pos[:upto], vel[:upto], there[:upto] & present[None, :],
+                                 gaps[:upto], horizons, sidestep_mps * dt_s, return_mps * dt_s,
+                                 bounds.get(w.person_id), dt_s, hold)
+            if offsets is not None:
+                w.detour = (times, offsets)
+                return base + offsets
+        return base
 
     for w in fixed:  # they keep to their paths
         where, _, present = w.path_positions(times)
-        place(where, present)
-    bounds = bounds or {}
+        place(m, where, present)
+        m += 1
+    paths = [w.path_positions(times) for w in visitors]
+    first = m
+    for base, _, present in paths:  # everyone's path, each replaced by its detour once it has one
+        place(m, base, present)
+        m += 1
+    for i, (w, (base, heading, present)) in enumerate(zip(visitors, paths)):
+        row = first + i
+        there[row] = False  # not from themselves
+        standing = np.hypot(*np.gradient(base, dt_s, axis=0).T) < 0.05 if len(times) > 1 else np.ones(len(times), bool)
+        place(row, detour(w, base, heading, present, m, standing), present)
     for w in yielding:
         base, heading, present = w.path_positions(times)
-        if m:
-            offsets = _sidesteps(base, heading, pos[:m], vel[:m], there[:m] & present[None, :], gaps[:m],
-                                 horizons, sidestep_mps * dt_s, return_mps * dt_s, bounds.get(w.person_id), dt_s)
-            if offsets is not None:
-                w.detour = (times, offsets)
-                base = base + offsets
-        place(base, present)
+        place(m, detour(w, base, heading, present, m), present)
+        m += 1
 
 
 #: metres: the farthest a detour takes a walker from their path
@@ -84,12 +103,14 @@ _REACH_M = _MOST_M + 0.5
 _CHUNK_STEPS = 600
 
 
-def _sidesteps(base, heading, others, others_v, others_present, gaps, horizons, step_m, back_m, box, dt_s):
+def _sidesteps(base, heading, others, others_v, others_present, gaps, horizons, step_m, back_m, box, dt_s,
+               hold=None):
     """The offset (n, 2) from the path, world frame, metres, time step by time step, or None
     when nobody comes near.
 
     ``others`` and ``others_v`` (m, n, 2) are the others' places (m) and velocities (m/s),
-    ``others_present`` (m, n) whether each is there with this walker. Each step looks at
+    ``others_present`` (m, n) whether each is there with this walker; where ``hold`` (n,) is
+    set, the walker stands: they neither step aside nor drift back. Each step looks at
     where this walker and the others will be ``horizons`` steps ahead and
     steps aside across their motion relative to the other (out of the other's way), enough
     to clear each of them by their ``gaps`` (m, one per other). Plain floats: a step meets
@@ -112,7 +133,8 @@ def _sidesteps(base, heading, others, others_v, others_present, gaps, horizons, 
         near, where, moving = _close_tables(k0, k1, close, others, others_v, gaps, horizons)
         busy = set().union(*(t.keys() for t in near.values()))
         for k in range(k0, k1):
-            if k not in busy and ox == 0.0 and oy == 0.0:
+            if (k not in busy and ox == 0.0 and oy == 0.0) or (hold is not None and hold[k]):
+                offsets[k] = ox, oy
                 continue
             size = math.hypot(ox, oy)  # drift back to the path
             keep = max(0.0, 1.0 - back_m / size) if size > 0 else 0.0

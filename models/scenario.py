@@ -23,7 +23,7 @@ file, radians inside)::
     visitors: {count, door: [x, y], area: [x0, y0, x1, y1], range_m: [lo, hi], stand_s: [lo, hi],
                arrive_every_s: [lo, hi], speed: [lo, hi], face_to_face: pairs, distance_m: [lo, hi]}
     furniture: {count, area: [x0, y0, x1, y1], range_m: [lo, hi], radius_m: [lo, hi], spacing_m: [lo, hi]}
-    keep_apart_m: 0.45        # m between torsos that crowd members and passers-by keep (0: none)
+    keep_apart_m: 0.45        # m between torsos that crowd members, passers-by and visitors keep (0: none)
 
 ``visitors`` walk in from the door one after another, stand at a spot of their own in ``area``
 (``range_m`` from the sensor) for ``stand_s`` and walk out; ``face_to_face`` pairs of them
@@ -43,6 +43,8 @@ Crowd members and passers-by step aside rather than walk through anyone: each ke
 ``keep_apart_m`` between torsos from the people listed, the visitors and those of them drawn
 before, and half of it from pillars, trees and furniture legs
 (:func:`~people_tracker.models.keep_apart.keep_apart`; crowd members within their area).
+Visitors do the same while they walk, for the people listed and every other visitor (whoever
+walks past someone standing makes way), and hold their place while they stand.
 
 Every key is checked: an unknown one is an error that names it.
 """
@@ -460,9 +462,11 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
     furniture = _furniture(spec["furniture"] or {}, rng, sensor_xy) if "furniture" in spec else np.zeros((0, 3))
     if len(furniture):
         world = World(world.segments, np.vstack([world.circles, furniture]))
+    visitors = []
     if "visitors" in spec:
-        walkers += _visitors(spec["visitors"] or {}, 1 + max([w.person_id for w in walkers], default=0), rng,
+        visitors = _visitors(spec["visitors"] or {}, 1 + max([w.person_id for w in walkers], default=0), rng,
                              sensor_xy, furniture)
+        walkers += visitors
     duration = _num(spec, "duration_s", 20.0, "", 0.0, 86400.0, lo_open=True)
     target_id = None
     if "follow" in robot:
@@ -487,11 +491,11 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
         passers += group
         walkers += group
     yielding = crowd + passers
-    moved = {id(w) for w in yielding}
-    fixed = [w for w in walkers if id(w) not in moved]  # the people listed and the visitors
+    moved = {id(w) for w in yielding + visitors}
+    fixed = [w for w in walkers if id(w) not in moved]  # the people listed
     area = _crowd_area(spec.get("crowd", {}) or {})
     keep_apart(fixed, yielding, duration, _num(spec, "keep_apart_m", GAP_M, "", 0.0, 5.0),
-               bounds={w.person_id: area for w in crowd}, obstacles=world.circles)
+               bounds={w.person_id: area for w in crowd}, obstacles=world.circles, visitors=visitors)
     sim = Simulation(laser, world, walkers, rng, mount=mount, start=start, driver=driver,
                      odom_trans_noise=_num(noise, "trans", 0.0, "robot.odometry_noise.", 0.0, 1.0),
                      odom_rot_noise=_num(noise, "rot", 0.0, "robot.odometry_noise.", 0.0, 1.0),

@@ -105,6 +105,24 @@ def test_people_step_aside_rather_than_walk_through_each_other(name, seconds):
                          for w in crowd for t in times)
 
 
+@pytest.mark.parametrize("seed", [21, 22])
+def test_visitors_walk_round_those_standing_and_hold_their_place(seed):
+    spec = load_scenario("waiting_room")
+    times = np.arange(0.0, spec["duration_s"], 0.1)
+    sim, _ = build_simulation(spec, seed=seed)
+    through, _ = build_simulation({**spec, "keep_apart_m": 0}, seed=seed)
+    close, apart = _closest_pairs(through.walkers, times), _closest_pairs(sim.walkers, times)
+    assert close[0.40] > 1.0, close  # straight from the door to their spot and back, through others
+    assert apart[0.30] == 0.0 and apart[0.40] < 0.1 * close[0.40], (apart, close)
+    stepped = [w for w in sim.walkers if w.detour is not None]
+    assert stepped  # someone made way
+    for w in stepped:  # ... only while walking: standing, a visitor does not budge
+        t, offsets = w.detour
+        pos, _, _ = w.path_positions(t)
+        still = np.hypot(*np.gradient(pos, t[1] - t[0], axis=0).T) < 0.05
+        assert np.hypot(*np.diff(offsets, axis=0)[still[1:]].T).max(initial=0.0) == 0.0
+
+
 def _seconds_at_obstacles(sim, times, within_m):
     """Seconds the crowd's torsos spend within ``within_m`` of a pillar's edge (m), and the
     deepest they go (negative: inside it)."""
