@@ -105,7 +105,9 @@ class StoodPlace:
     came: float  # when they came (their track last moved), s
 
 
-PASSING_MPS = 0.5  # m/s: a track this fast passing close by someone standing is a passer-by, not them twice
+# m/s: a track this fast passing close by someone standing is a passer-by, not them twice (a
+# walker's estimated speed lags: one setting off or slowing beside them reads 0.4-0.5 m/s at 0.7)
+PASSING_MPS = 0.3
 SET_OFF_S = 3.0  # s: a track this young that began beside someone standing may be them, set off
 TURN_S = 1.0  # s: a walker whose legs were last seen moving this recently may have turned sharply
 
