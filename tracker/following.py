@@ -30,10 +30,11 @@ class TargetSelector:
     Parameters
     ----------
     mode : 'auto', an int track id, or None
-        ``auto`` locks onto the closest reported person ahead of the sensor (within
-        ``ahead_deg`` of its x axis and ``lock_range_m`` of it: the person to follow stands
-        or walks close in front of the robot) whenever there is no target; an id follows
-        that track once it exists.
+        ``auto`` locks onto the reported person most nearly straight ahead of the sensor,
+        within ``lane_m`` of its x axis, ``ahead_deg`` of it and ``lock_range_m`` of the
+        sensor (the person to follow stands or walks close in front of the robot, in its
+        way; someone crossing or walking by to one side is not them), whenever there is no
+        target; an id follows that track once it exists.
     reacquire_s : float
         How long (s) after the target's track broke off another track may still take the
         person's id; then an ``auto`` selector locks anew.
@@ -63,13 +64,14 @@ class TargetSelector:
     def __init__(self, mode: str | int | None, reacquire_s: float = 10.0, reacquire_m: float = 0.8,
                  ahead_deg: float = 60.0, lock_range_m: float = 3.5, walk_mps: float = 1.5,
                  coast_s: float = 0.5, max_reach_m: float = 4.0, steady_s: float = 1.5,
-                 slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35) -> None:
+                 slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35,
+                 lane_m: float = 0.75) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
         self._ahead_rad, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
         self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
-        self.relock_s, self._same_person_m = relock_s, same_person_m
+        self.relock_s, self._same_person_m, self._lane_m = relock_s, same_person_m, lane_m
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
         self._v = np.zeros(2)  # ... its rate of change (m/s) ...
@@ -179,7 +181,9 @@ class TargetSelector:
         """The target id now, given reported tracks (id → sensor-frame place, m)."""
         if self.target is not None or self.mode != "auto":
             return self.target
-        best = self._ahead(reported)
+        lane = [(abs(float(reported[tid][1])), tid) for tid in self.in_front(reported)
+                if abs(float(reported[tid][1])) <= self._lane_m]
+        best = min(lane)[1] if lane else None
         if best is not None:
             self.target = best
             self.events.append(f"target {best}")
