@@ -3,7 +3,7 @@
 The `follow_outdoor` scene: person 1 walks round a building and across an open field with a
 few trees and posts, turning sharply, stopping, while passers-by cross between them and the
 robot; sunlight adds spurious short readings. The robot has no odometry: each scan goes
-through the tracker alone (`--follow auto` locks onto the closest person ahead), and the
+through the tracker alone (`--follow auto` locks onto the person straight ahead), and the
 robot's velocity command comes from where the tracker says the target is (when the target is
 lost, from where it was last seen, for up to 10 s). The simulator's truth is used only to
 score the run, with `evaluate`'s following protocol.

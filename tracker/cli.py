@@ -84,7 +84,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--detections", metavar="FILE.csv", help="write the moving objects of every scan")
     run.add_argument("--tracks", metavar="FILE.csv", help="write the confirmed people of every scan")
     run.add_argument("--legs", metavar="FILE.csv", help="write every leg candidate of every scan with its probability")
-    run.add_argument("--follow", metavar="auto|ID", help="follow a person: the closest ahead (auto) or a track id")
+    run.add_argument("--follow", metavar="auto|ID", help="follow a person: the one straight ahead (auto) or a track id")
     run.add_argument("--rrd", metavar="FILE.rrd", help="save a rerun recording of every stage")
     run.add_argument("--spawn", action="store_true", help="open the rerun viewer and stream to it")
 
@@ -143,7 +143,7 @@ def _build_parser() -> argparse.ArgumentParser:
                      help="the laser in the odometry's base frame: metres, metres, degrees (0 0 0)")
     ros.add_argument("--fixed-frame", default="odom", help="frame of the published positions (%(default)s)")
     ros.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
-    ros.add_argument("--follow", metavar="auto|ID", help="follow a person: the closest ahead (auto) or a track id")
+    ros.add_argument("--follow", metavar="auto|ID", help="follow a person: the one straight ahead (auto) or a track id")
     ros.add_argument("--legs", action="store_true", help="also publish the likely leg candidates on legs")
     ros.add_argument("--queue", type=int, default=10, metavar="N",
                      help="scans waiting to be tracked before the oldest is dropped (%(default)s); more trades "
