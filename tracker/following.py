@@ -30,11 +30,13 @@ class TargetSelector:
     Parameters
     ----------
     mode : 'auto', an int track id, or None
-        ``auto`` locks onto the reported person most nearly straight ahead of the sensor,
-        within ``lane_m`` of its x axis, ``ahead_deg`` of it and ``lock_range_m`` of the
-        sensor (the person to follow stands or walks close in front of the robot, in its
-        way; someone crossing or walking by to one side is not them), whenever there is no
-        target; an id follows that track once it exists.
+        ``auto`` first locks onto the reported person most nearly straight ahead of the
+        sensor, within ``lane_m`` of its x axis, ``ahead_deg`` of it and ``lock_range_m`` of
+        the sensor (the person to follow stands or walks close in front of the robot, in
+        its way; someone crossing or walking by to one side is not them); once a person it
+        followed was lost for good (``reacquire_s``), onto the closest reported person in
+        that zone ahead, whoever comes back into view (the robot waits where it lost them).
+        An id follows that track once it exists.
     reacquire_s : float
         How long (s) after the target's track broke off another track may still take the
         person's id; then an ``auto`` selector locks anew.
@@ -72,6 +74,7 @@ class TargetSelector:
         self._ahead_rad, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
         self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
         self.relock_s, self._same_person_m, self._lane_m = relock_s, same_person_m, lane_m
+        self._gave_up = False  # whether a person locked onto was ever lost for good
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
         self._v = np.zeros(2)  # ... its rate of change (m/s) ...
@@ -144,6 +147,7 @@ class TargetSelector:
             return None
         if stamp - self.lost_since > self._reacquire_s:
             self.events.append(f"gave up {self.target}")
+            self._gave_up = True
             self.lost_since = None
             if self.mode == "auto":
                 self.target, self._q, self._t, self._v, self.steady = None, None, None, np.zeros(2), None
@@ -181,9 +185,12 @@ class TargetSelector:
         """The target id now, given reported tracks (id → sensor-frame place, m)."""
         if self.target is not None or self.mode != "auto":
             return self.target
-        lane = [(abs(float(reported[tid][1])), tid) for tid in self.in_front(reported)
-                if abs(float(reported[tid][1])) <= self._lane_m]
-        best = min(lane)[1] if lane else None
+        if self._gave_up:  # they went: whoever comes back closest ahead is most likely them
+            best = self._ahead(reported)
+        else:  # following starts: the person to follow stands in the robot's way
+            lane = [(abs(float(reported[tid][1])), tid) for tid in self.in_front(reported)
+                    if abs(float(reported[tid][1])) <= self._lane_m]
+            best = min(lane)[1] if lane else None
         if best is not None:
             self.target = best
             self.events.append(f"target {best}")

@@ -339,3 +339,15 @@ def test_stance_partners_bring_a_walkers_lone_legs_nearer_the_torso():
                     if len(c.object_ids) == 1 and c.kind in ("leg", "pair") and np.hypot(c.x - torso[0], c.y - torso[1]) < 0.8]
         errors[on] = float(np.mean(err))
     assert errors[True] < errors[False] - 0.02, errors
+
+
+def test_following_starts_with_the_person_in_the_robots_way():
+    sel = TargetSelector("auto")
+    aside = {2: np.array([2.4, 1.1])}  # a crowd member 2.6 m away, 1.1 m to the left
+    assert sel.choose(aside) is None  # to one side: not who the robot is to follow
+    beside = {**aside, 3: np.array([0.8, -0.4])}  # a passer-by 0.9 m away, 0.4 m to the right
+    ahead = {**beside, 4: np.array([2.0, 0.05])}  # the person, 2 m straight ahead
+    assert sel.choose(ahead) == 4  # farther, but most nearly in the robot's way
+    sel.lost(1.0)
+    assert sel.reacquire(11.5, {}) is None and sel.target is None  # gone for good (reacquire_s)
+    assert sel.choose({**aside, 5: np.array([2.5, 1.2])}) == 2  # then whoever comes back closest ahead
