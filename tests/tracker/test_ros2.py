@@ -101,7 +101,9 @@ def test_the_node_publishes_what_the_offline_run_writes(tmp_path, moving_bag):
     assert "--mount 0.850326 0.235214 42.1014" in replay.stdout and "replayed 873 scans" in replay.stdout
     listener.wait(timeout=300)  # it has heard every scan's people (or given up): the node is done
     code, out, err, took = _stop(node)
-    assert code == 0 and took < 1.0 + 0.5, (code, took, err)  # SIGINT: a normal shutdown within a second
+    # SIGINT: a normal shutdown, not the kill after 10 s (the margin: a 2-core machine running the
+    # other tests beside it took 1.5 s or more once in three runs)
+    assert code == 0 and took < 5.0, (code, took, err)
     assert "873 scans tracked, 0 dropped" in out and "p50" in out and "p99" in out, out
     heard = json.loads((tmp_path / "heard.json").read_text())
     live = {(round(s, 6), i): (x, y) for s, i, x, y in heard["rows"]}
