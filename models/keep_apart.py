@@ -64,12 +64,12 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
         vel[row] = np.gradient(where, dt_s, axis=0) if len(times) > 1 else 0.0
 
     def detour(w: Walker, base: np.ndarray, heading: np.ndarray, present: np.ndarray, upto: int,
-               hold: np.ndarray | None = None) -> np.ndarray:
+               hold_when_still: bool = False) -> np.ndarray:
         """``w``'s path with the detour that keeps them clear of rows ``:upto`` (set on them)."""
         if upto:
             offsets = _sidesteps(base, heading, pos[:upto], vel[:upto], there[:upto] & present[None, :],
                                  gaps[:upto], horizons, sidestep_mps * dt_s, return_mps * dt_s,
-                                 bounds.get(w.person_id), dt_s, hold)
+                                 bounds.get(w.person_id), dt_s, hold_when_still)
             if offsets is not None:
                 w.detour = (times, offsets)
                 return base + offsets
@@ -87,8 +87,7 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
     for i, (w, (base, heading, present)) in enumerate(zip(visitors, paths)):
         row = first + i
         there[row] = False  # not from themselves
-        standing = np.hypot(*np.gradient(base, dt_s, axis=0).T) < 0.05 if len(times) > 1 else np.ones(len(times), bool)
-        place(row, detour(w, base, heading, present, m, standing), present)
+        place(row, detour(w, base, heading, present, m, hold_when_still=True), present)
     for w in yielding:
         base, heading, present = w.path_positions(times)
         place(m, detour(w, base, heading, present, m), present)
@@ -101,16 +100,19 @@ _MOST_M = 1.0
 _REACH_M = _MOST_M + 0.5
 #: time steps whose tables of who is close are built at once (a minute at 0.1 s)
 _CHUNK_STEPS = 600
+#: m/s: a path slower than this stands still (a visitor at their spot)
+_STILL_MPS = 0.05
 
 
 def _sidesteps(base, heading, others, others_v, others_present, gaps, horizons, step_m, back_m, box, dt_s,
-               hold=None):
+               hold_when_still=False):
     """The offset (n, 2) from the path, world frame, metres, time step by time step, or None
     when nobody comes near.
 
     ``others`` and ``others_v`` (m, n, 2) are the others' places (m) and velocities (m/s),
-    ``others_present`` (m, n) whether each is there with this walker; where ``hold`` (n,) is
-    set, the walker stands: they neither step aside nor drift back. Each step looks at
+    ``others_present`` (m, n) whether each is there with this walker; with
+    ``hold_when_still``, wherever their path stands still (below ``_STILL_MPS``) the walker
+    neither steps aside nor drifts back. Each step looks at
     where this walker and the others will be ``horizons`` steps ahead and
     steps aside across their motion relative to the other (out of the other's way), enough
     to clear each of them by their ``gaps`` (m, one per other). Plain floats: a step meets
@@ -125,6 +127,7 @@ def _sidesteps(base, heading, others, others_v, others_present, gaps, horizons, 
     bx, by = base[:, 0].tolist(), base[:, 1].tolist()
     hx, hy = heading[:, 0].tolist(), heading[:, 1].tolist()
     vx, vy = own_v[:, 0].tolist(), own_v[:, 1].tolist()
+    hold = ((np.hypot(own_v[:, 0], own_v[:, 1]) < _STILL_MPS) if hold_when_still else np.zeros(n, dtype=bool)).tolist()
     offsets = np.zeros((n, 2))
     ox = oy = 0.0
     order = horizons[::-1] * 4
@@ -133,7 +136,7 @@ def _sidesteps(base, heading, others, others_v, others_present, gaps, horizons, 
         near, where, moving = _close_tables(k0, k1, close, others, others_v, gaps, horizons)
         busy = set().union(*(t.keys() for t in near.values()))
         for k in range(k0, k1):
-            if (k not in busy and ox == 0.0 and oy == 0.0) or (hold is not None and hold[k]):
+            if (k not in busy and ox == 0.0 and oy == 0.0) or hold[k]:
                 offsets[k] = ox, oy
                 continue
             size = math.hypot(ox, oy)  # drift back to the path

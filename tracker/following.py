@@ -188,9 +188,9 @@ class TargetSelector:
         if self._gave_up:  # they went: whoever comes back closest ahead is most likely them
             best = self._ahead(reported)
         else:  # following starts: the person to follow stands in the robot's way
-            lane = [(abs(float(reported[tid][1])), tid) for tid in self.in_front(reported)
-                    if abs(float(reported[tid][1])) <= self._lane_m]
-            best = min(lane)[1] if lane else None
+            aside = {tid: abs(float(reported[tid][1])) for tid in self.in_front(reported)}  # m off the axis
+            lane = [tid for tid, off in aside.items() if off <= self._lane_m]
+            best = min(lane, key=lambda tid: (aside[tid], tid)) if lane else None
         if best is not None:
             self.target = best
             self.events.append(f"target {best}")
