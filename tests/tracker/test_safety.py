@@ -100,7 +100,19 @@ def test_ctrl_c_ends_a_run_with_130_and_no_files(tmp_path, extra):
     proc = subprocess.Popen(cli_command() + ["run", str(bag), "--tracks", "t.csv", "--detections", "d.csv", *extra],
                             cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    time.sleep(2.0)  # well into the 873 scans
+    # interrupt once the first rows have reached the hidden output file: well into the 873
+    # scans however fast the machine is (a fixed sleep let a fast machine finish first)
+    deadline = time.monotonic() + 60
+    def written():
+        try:
+            return any(f.name.endswith(".part") and f.stat().st_size > 0 for f in tmp_path.iterdir())
+        except FileNotFoundError:  # moved into place between the listing and the stat
+            return False
+
+    while not written():
+        assert proc.poll() is None, "the run ended before any output reached its temporary file"
+        assert time.monotonic() < deadline, "no output reached a temporary file within 60 s"
+        time.sleep(0.01)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=20)
     assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err
