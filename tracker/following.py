@@ -155,7 +155,12 @@ class TargetSelector:
         if self.mode != "auto":  # the id goes to the one track within reach of where they should be
             best = self.only_one_near(stamp, others)
         elif stamp - self.lost_since >= self.relock_s:  # the person is the one in front of the robot
-            best = self._ahead(others, only=True)
+            # as far ahead as they could have gone in the moment before the re-lock: the robot
+            # may have fallen back while they were unseen
+            exp = self.expected(stamp)
+            margin = min(self._reacquire_m + self._walk * self.relock_s, self._max_reach)
+            far = self._lock_range if exp is None else max(self._lock_range, float(np.hypot(*exp[0])) + margin)
+            best = self._ahead(others, only=True, range_m=far)
             if best is not None:  # where they are now is learnt afresh
                 self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
         else:
@@ -165,16 +170,18 @@ class TargetSelector:
             self.events.append(f"re-acquired {self.target}")
         return best
 
-    def in_front(self, tracks: dict[int, np.ndarray]) -> list[int]:
-        """The tracks (id → sensor-frame place, m) in the follow zone ahead, closest first."""
+    def in_front(self, tracks: dict[int, np.ndarray], range_m: float | None = None) -> list[int]:
+        """The tracks (id → sensor-frame place, m) in the follow zone ahead (out to ``range_m``,
+        by default ``lock_range_m``), closest first."""
+        range_m = self._lock_range if range_m is None else range_m
         ahead = [(math.hypot(x, y), tid) for tid, (x, y) in tracks.items()
-                 if abs(math.atan2(y, x)) <= self._ahead_rad and math.hypot(x, y) <= self._lock_range]
+                 if abs(math.atan2(y, x)) <= self._ahead_rad and math.hypot(x, y) <= range_m]
         return [tid for _, tid in sorted(ahead, key=lambda rt: rt[0])]
 
-    def _ahead(self, tracks: dict[int, np.ndarray], only: bool = False) -> int | None:
-        """The closest track (id → sensor-frame place, m) in the follow zone ahead (with
-        ``only``, when the tracks there are one person's), or None."""
-        ahead = self.in_front(tracks)
+    def _ahead(self, tracks: dict[int, np.ndarray], only: bool = False, range_m: float | None = None) -> int | None:
+        """The closest track (id → sensor-frame place, m) in the follow zone ahead (out to
+        ``range_m``; with ``only``, when the tracks there are one person's), or None."""
+        ahead = self.in_front(tracks, range_m)
         if not ahead:
             return None
         if only and any(math.dist(tracks[tid], tracks[ahead[0]]) > self._same_person_m for tid in ahead[1:]):

@@ -91,6 +91,17 @@ def test_a_lost_person_is_the_one_track_in_front_when_nobody_is_where_they_shoul
     assert sel.lost_since is None and sel.expected(1.3) is None  # their place is learnt afresh from that track
 
 
+def test_a_lost_person_is_looked_for_as_far_ahead_as_they_could_have_gone():
+    beyond_zone, farther_still = np.array([5.0, 0.3]), np.array([6.0, 0.0])  # 3.2 m + 0.8 m + 1.5 m/s x 1 s = 5.5 m
+    for others, expect in (({7: beyond_zone}, 7), ({8: farther_still}, None)):
+        sel = TargetSelector("auto", lock_range_m=3.5, reacquire_m=0.8, walk_mps=1.5, relock_s=1.0)
+        sel.target = 1
+        sel.seen(0.0, np.array([3.2, 0.0]))  # straight ahead, near the edge of the lock zone
+        sel.lost(0.1)
+        assert sel.reacquire(1.2, others) == expect  # the robot fell back while they were unseen, but not that far
+    assert TargetSelector("auto").choose({7: beyond_zone}) is None  # the first lock keeps to the zone
+
+
 def test_a_lost_person_followed_automatically_is_not_handed_to_whoever_is_where_they_should_be():
     sel = TargetSelector("auto")
     sel.target = 1
