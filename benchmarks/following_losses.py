@@ -8,8 +8,9 @@ Runs the default tracker with ``--follow auto`` on one simulated following run a
 every scan where the person is visible, after the first lock, into: the target is on them
 (within 0.75 m, sensor frame); on someone or something else; no target while a reported
 track is on them (the tracker has them, the target model gave the id to no one: lost for
-less than ``relock_s``, or after it, how many reported tracks lay in the zone ahead where
-the person is looked for: with two or more the id goes to none);
+less than ``relock_s``, or after it, how many reported tracks lay where the re-lock looks
+for the person, the zone ahead and beyond it where they could be: with two or more the id
+goes to none);
 no target while only an unreported track is on them; no target and no track near them.
 The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
 """
@@ -55,9 +56,9 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
             elif stamp - sel.lost_since < sel.relock_s:
                 why = f"lost for less than {sel.relock_s:g} s"
             else:
-                ahead = len(sel.in_front(here))
-                why = "they are not in the zone ahead" if ahead == 0 else \
-                    f"{min(ahead, 3)}{'+' if ahead >= 3 else ''} reported tracks in the zone ahead"
+                ahead = len(sel.looked_for(stamp, here))
+                why = "they are not where the re-lock looks" if ahead == 0 else \
+                    f"{min(ahead, 3)}{'+' if ahead >= 3 else ''} reported tracks where the re-lock looks"
             out[f"no target, a reported track on them: {why}"] += 1
         elif any(float(np.hypot(*(q - truth.torso_sensor[k[0]]))) <= NEAR_M
                  for q in tracks_in_sensor_frame([u.report() for u in tracker._tracks], tracker.last.pose)):

@@ -48,7 +48,9 @@ class TargetSelector:
     relock_s : float
         ``auto``: when the person has been lost this long (s), the one person in the lock
         zone ahead (none when there are several) takes their id, and their place is learnt
-        afresh from them.
+        afresh from them. Beyond the zone's ``lock_range_m``, a track within reach of where
+        they should be counts too, out to their last range plus the reach they had when
+        the re-lock began (:meth:`looked_for`): the robot may have fallen back.
     same_person_m : float
         Reported tracks in the zone ahead all within this distance (m) of the closest of
         them are one person seen twice (a track on each leg), not several people: the
@@ -155,12 +157,7 @@ class TargetSelector:
         if self.mode != "auto":  # the id goes to the one track within reach of where they should be
             best = self.only_one_near(stamp, others)
         elif stamp - self.lost_since >= self.relock_s:  # the person is the one in front of the robot
-            # as far ahead as they could have gone in the moment before the re-lock: the robot
-            # may have fallen back while they were unseen
-            exp = self.expected(stamp)
-            margin = min(self._reacquire_m + self._walk * self.relock_s, self._max_reach)
-            far = self._lock_range if exp is None else max(self._lock_range, float(np.hypot(*exp[0])) + margin)
-            best = self._ahead(others, only=True, range_m=far)
+            best = self._first(self.looked_for(stamp, others), others, only=True)
             if best is not None:  # where they are now is learnt afresh
                 self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
         else:
@@ -178,10 +175,26 @@ class TargetSelector:
                  if abs(math.atan2(y, x)) <= self._ahead_rad and math.hypot(x, y) <= range_m]
         return [tid for _, tid in sorted(ahead, key=lambda rt: rt[0])]
 
-    def _ahead(self, tracks: dict[int, np.ndarray], only: bool = False, range_m: float | None = None) -> int | None:
-        """The closest track (id → sensor-frame place, m) in the follow zone ahead (out to
-        ``range_m``; with ``only``, when the tracks there are one person's), or None."""
-        ahead = self.in_front(tracks, range_m)
+    def looked_for(self, stamp: float, tracks: dict[int, np.ndarray]) -> list[int]:
+        """The tracks (id → sensor-frame place, m) among which the re-lock looks for the lost
+        person, closest first: those in the follow zone ahead, and beyond it those where the
+        person could be (within reach of where they should be) out to as far as they could
+        have gone before the re-lock: the robot may have fallen back while they were unseen."""
+        exp = self.expected(stamp)
+        if exp is None:
+            return self.in_front(tracks)
+        margin = min(self._reacquire_m + self._walk * self.relock_s, self._max_reach)
+        far = max(self._lock_range, float(np.hypot(*exp[0])) + margin)
+        return [tid for tid in self.in_front(tracks, far)
+                if math.hypot(*tracks[tid]) <= self._lock_range or self.within_reach(stamp, tracks[tid])]
+
+    def _ahead(self, tracks: dict[int, np.ndarray]) -> int | None:
+        """The closest track (id → sensor-frame place, m) in the follow zone ahead, or None."""
+        return self._first(self.in_front(tracks), tracks)
+
+    def _first(self, ahead: list[int], tracks: dict[int, np.ndarray], only: bool = False) -> int | None:
+        """The first of ``ahead`` (ids of ``tracks``, id → sensor-frame place, m; with
+        ``only``, when the tracks there are one person's), or None."""
         if not ahead:
             return None
         if only and any(math.dist(tracks[tid], tracks[ahead[0]]) > self._same_person_m for tid in ahead[1:]):

@@ -93,7 +93,8 @@ def test_a_lost_person_is_the_one_track_in_front_when_nobody_is_where_they_shoul
 
 def test_a_lost_person_is_looked_for_as_far_ahead_as_they_could_have_gone():
     beyond_zone, farther_still = np.array([5.0, 0.3]), np.array([6.0, 0.0])  # 3.2 m + 0.8 m + 1.5 m/s x 1 s = 5.5 m
-    for others, expect in (({7: beyond_zone}, 7), ({8: farther_still}, None)):
+    elsewhere = np.array([4.5, -2.4])  # as far, but 3 m from where they were: beyond the zone, only where they could be
+    for others, expect in (({7: beyond_zone}, 7), ({8: farther_still}, None), ({9: elsewhere}, None)):
         sel = TargetSelector("auto", lock_range_m=3.5, reacquire_m=0.8, walk_mps=1.5, relock_s=1.0)
         sel.target = 1
         sel.seen(0.0, np.array([3.2, 0.0]))  # straight ahead, near the edge of the lock zone

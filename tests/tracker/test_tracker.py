@@ -63,9 +63,11 @@ def test_occlusion_keeps_the_hidden_person():
 def test_following_keeps_one_target_id():
     _, targets, trk = run_scene("crossing", follow="auto")
     ids, people = {tid for _, tid, _ in targets}, {p for _, _, p in targets}
-    # one id, always on the person first locked: where the two cross, the target is lost for
-    # about a second rather than given to whoever is near, then re-locked in front
-    assert len(ids) == 1 and len(people) == 1 and len(targets) > 110, (ids, people, len(targets))
+    # one id, always on the person first locked: where the two cross, the target is lost
+    # rather than given to whoever is near, then re-locked in front once only they could be it
+    # (103 of the scene's 200 scans since the re-lock also looks beyond the lock zone, where
+    # they could be: the other walker stays a candidate 1.5 s longer; 118 before)
+    assert len(ids) == 1 and len(people) == 1 and len(targets) > 100, (ids, people, len(targets))
     assert trk.selector.events[0].startswith("target ")
     # the first lock waits for someone in the robot's way, within 0.75 m of its axis: person 1,
     # walking across at 2.8 m from y = -6 m at 1 m/s, gets there after 5.25 s (about scan 53),
