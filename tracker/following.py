@@ -185,8 +185,9 @@ class TargetSelector:
             return self.in_front(tracks)
         margin = min(self._reacquire_m + self._walk * self.relock_s, self._max_reach)
         far = max(self._lock_range, float(np.hypot(*exp[0])) + margin)
+        where, reach = exp
         return [tid for tid in self.in_front(tracks, far)
-                if math.hypot(*tracks[tid]) <= self._lock_range or self.within_reach(stamp, tracks[tid])]
+                if math.hypot(*tracks[tid]) <= self._lock_range or math.dist(tracks[tid], where) <= reach]
 
     def _ahead(self, tracks: dict[int, np.ndarray]) -> int | None:
         """The closest track (id → sensor-frame place, m) in the follow zone ahead, or None."""

@@ -102,13 +102,13 @@ def test_ctrl_c_ends_a_run_with_130_and_no_files(tmp_path, extra):
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     # interrupt once the first rows have reached the hidden output file: well into the 873
     # scans however fast the machine is (a fixed sleep let a fast machine finish first)
-    deadline = time.monotonic() + 60
     def written():
         try:
             return any(f.name.endswith(".part") and f.stat().st_size > 0 for f in tmp_path.iterdir())
         except FileNotFoundError:  # moved into place between the listing and the stat
             return False
 
+    deadline = time.monotonic() + 60
     while not written():
         assert proc.poll() is None, "the run ended before any output reached its temporary file"
         assert time.monotonic() < deadline, "no output reached a temporary file within 60 s"
