@@ -10,7 +10,8 @@ coasts while a fresh track appears where the person should be, the person's id g
 track at that place — when exactly one is there; when more than one could be them, the
 person is reported lost rather than swapped for someone else. An ``auto`` selector (the
 robot follows whoever it locked onto in front of it) gives a lost person's id instead to
-the one person in front of the robot after a moment, if there is exactly one: a robot
+the one person in front of the robot after a moment, if there is exactly one (of several,
+the one clearly walking as the person last walked, by their world-frame velocity): a robot
 following someone has them in front of it, wherever a drifting or turned estimate says
 they went, and the one track near that estimate was more often a passer-by than them.
 """
@@ -50,7 +51,10 @@ class TargetSelector:
         zone ahead (none when there are several) takes their id, and their place is learnt
         afresh from them. Beyond the zone's ``lock_range_m``, a track within reach of where
         they should be counts too, out to their last range plus the reach they had when
-        the re-lock began (:meth:`looked_for`): the robot may have fallen back.
+        the re-lock began (:meth:`looked_for`): the robot may have fallen back. With several
+        there, the one walking as the person last walked takes the id, when it is clearly
+        them: its world-frame velocity within ``same_velocity_mps`` (m/s) of theirs and every
+        other's more than ``other_velocity_mps`` from it (:meth:`_walking_on`).
     same_person_m : float
         Reported tracks in the zone ahead all within this distance (m) of the closest of
         them are one person seen twice (a track on each leg), not several people: the
@@ -69,7 +73,7 @@ class TargetSelector:
                  ahead_deg: float = 60.0, lock_range_m: float = 3.5, walk_mps: float = 1.5,
                  coast_s: float = 0.5, max_reach_m: float = 4.0, steady_s: float = 1.5,
                  slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35,
-                 lane_m: float = 0.75) -> None:
+                 lane_m: float = 0.75, same_velocity_mps: float = 0.2, other_velocity_mps: float = 1.2) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
@@ -84,11 +88,15 @@ class TargetSelector:
         self._yaw = 0.0  # the sensor's heading (world frame, rad) when the person was last seen ...
         self.yaw = 0.0  # ... and now (the tracker sets it every scan)
         self.lost_since: float | None = None  # when the target's track broke off, while it is missing
+        self.velocity: np.ndarray | None = None  # the person's velocity when last seen (world frame, m/s)
+        self._same_velocity, self._other_velocity = same_velocity_mps, other_velocity_mps
         self.events: list[str] = []
 
-    def seen(self, stamp: float, q: np.ndarray) -> None:
-        """The target's track was updated at ``stamp`` (s), at ``q`` in the sensor frame (m)."""
+    def seen(self, stamp: float, q: np.ndarray, velocity: np.ndarray | None = None) -> None:
+        """The target's track was updated at ``stamp`` (s), at ``q`` in the sensor frame (m),
+        walking at ``velocity`` (world frame, m/s; None when not known)."""
         q = np.asarray(q, dtype=float)
+        self.velocity = None if velocity is None else np.array(velocity, dtype=float)
         if self._q is not None and self._t is not None and stamp > self._t:
             rate = (q - self._q) / (stamp - self._t)
             speed = float(np.hypot(*rate))
@@ -143,8 +151,10 @@ class TargetSelector:
         """Whether the target track at ``q`` (sensor frame, m) is far from where the person has been lately."""
         return self.steady is not None and float(np.hypot(*(np.asarray(q) - self.steady))) > self.slide_m
 
-    def reacquire(self, stamp: float, others: dict[int, np.ndarray]) -> int | None:
-        """Which other track (id → sensor-frame place) takes over the missing target's id."""
+    def reacquire(self, stamp: float, others: dict[int, np.ndarray],
+                  velocities: dict[int, np.ndarray] | None = None) -> int | None:
+        """Which other track (id → sensor-frame place) takes over the missing target's id
+        (``velocities``: id → world-frame velocity, m/s, when known)."""
         if self.lost_since is None or self.target is None:
             return None
         if stamp - self.lost_since > self._reacquire_s:
@@ -157,7 +167,10 @@ class TargetSelector:
         if self.mode != "auto":  # the id goes to the one track within reach of where they should be
             best = self.only_one_near(stamp, others)
         elif stamp - self.lost_since >= self.relock_s:  # the person is the one in front of the robot
-            best = self._first(self.looked_for(stamp, others), others, only=True)
+            looked = self.looked_for(stamp, others)
+            best = self._first(looked, others, only=True)
+            if best is None and len(looked) > 1:
+                best = self._walking_on(looked, velocities)
             if best is not None:  # where they are now is learnt afresh
                 self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
         else:
@@ -166,6 +179,17 @@ class TargetSelector:
             self.lost_since = None
             self.events.append(f"re-acquired {self.target}")
         return best
+
+    def _walking_on(self, candidates: list[int], velocities: dict[int, np.ndarray] | None) -> int | None:
+        """Of several candidate tracks, the one walking as the person last walked (its
+        world-frame velocity within ``same_velocity_mps`` of theirs) when every other walks
+        differently (more than ``other_velocity_mps`` from it); None otherwise."""
+        if velocities is None or self.velocity is None or any(tid not in velocities for tid in candidates):
+            return None
+        dv = sorted((float(np.hypot(*(velocities[tid] - self.velocity))), tid) for tid in candidates)
+        if dv[0][0] <= self._same_velocity and dv[1][0] > self._other_velocity:
+            return dv[0][1]
+        return None
 
     def in_front(self, tracks: dict[int, np.ndarray], range_m: float | None = None) -> list[int]:
         """The tracks (id → sensor-frame place, m) in the follow zone ahead (out to ``range_m``,

@@ -766,7 +766,7 @@ class PeopleTracker:
                     t = self._retire(t)
                     sel.lost(stamp)
             if t is not None and t.reported and t.updated_now:
-                sel.seen(stamp, q)
+                sel.seen(stamp, q, t.velocity)
             elif t is None or not t.reported:
                 sel.lost(stamp)
             elif stamp - t.last_update >= sel.coast_s:
@@ -775,14 +775,15 @@ class PeopleTracker:
                     t = self._retire(t)
                     sel.lost(stamp)
             if sel.lost_since is not None:
-                new_id = sel.reacquire(stamp, here(u for u in self._tracks if u.track_id != sel.target and u.reported))
+                others = [u for u in self._tracks if u.track_id != sel.target and u.reported]
+                new_id = sel.reacquire(stamp, here(others), {u.track_id: u.velocity for u in others})
                 if new_id is not None:
                     new = next(u for u in self._tracks if u.track_id == new_id)
                     new.track_id = sel.target  # the person keeps their id
         reported = here(u for u in self._tracks if u.reported)
         target = sel.choose(reported)
         if target is not None and sel.expected(stamp) is None and target in reported:
-            sel.seen(stamp, reported[target])
+            sel.seen(stamp, reported[target], next(u.velocity for u in self._tracks if u.track_id == target))
         return target
 
     def _retire(self, t: TrackState) -> None:

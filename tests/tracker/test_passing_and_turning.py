@@ -127,6 +127,28 @@ def test_a_lost_person_is_not_guessed_among_several_in_front():
     assert TargetSelector(5).reacquire(1.3, {7: np.array([2.2, 0.1])}) is None  # an id given by the user: never
 
 
+def test_of_several_in_front_the_one_walking_on_as_the_person_walked_takes_their_id():
+    walking = np.array([1.0, 0.0])  # m/s, world frame: the person walked on ahead of the robot
+    person, passer_by = np.array([2.0, 0.1]), np.array([1.6, -0.5])  # both in the zone ahead
+
+    def relock(person_v, passer_v, seen_v=walking):
+        sel = TargetSelector("auto", same_velocity_mps=0.2, other_velocity_mps=1.2)
+        sel.target = 1
+        sel.seen(0.0, np.array([1.5, 0.0]), seen_v)
+        sel.lost(0.2)
+        return sel.reacquire(1.3, {7: person, 8: passer_by}, {7: person_v, 8: passer_v})
+
+    assert relock(np.array([1.1, 0.1]), np.array([-1.0, 0.3])) == 7  # the passer-by comes the other way
+    assert relock(np.array([1.1, 0.1]), np.array([0.3, 0.9])) is None  # crossing at 1.1 m/s from their walk: unsure
+    assert relock(np.array([1.5, 0.0]), np.array([-1.0, 0.3])) is None  # neither walks as the person did
+    assert relock(np.array([1.1, 0.1]), np.array([-1.0, 0.3]), seen_v=None) is None  # their walk is not known
+    sel = TargetSelector("auto")
+    sel.target = 1
+    sel.seen(0.0, np.array([1.5, 0.0]), walking)
+    sel.lost(0.2)
+    assert sel.reacquire(1.3, {7: person, 8: passer_by}) is None  # no velocities given: nobody
+
+
 def test_two_tracks_in_front_closer_than_two_people_can_stand_are_one_person():
     sel = TargetSelector("auto", same_person_m=0.35)
     sel.target = 1
