@@ -169,7 +169,7 @@ class TargetSelector:
         elif stamp - self.lost_since >= self.relock_s:  # the person is the one in front of the robot
             looked = self.looked_for(stamp, others)
             best = self._first(looked, others, only=True)
-            if best is None and len(looked) > 1:
+            if best is None:
                 best = self._walking_on(looked, velocities)
             if best is not None:  # where they are now is learnt afresh
                 self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
@@ -184,7 +184,8 @@ class TargetSelector:
         """Of several candidate tracks, the one walking as the person last walked (its
         world-frame velocity within ``same_velocity_mps`` of theirs) when every other walks
         differently (more than ``other_velocity_mps`` from it); None otherwise."""
-        if velocities is None or self.velocity is None or any(tid not in velocities for tid in candidates):
+        if (len(candidates) < 2 or velocities is None or self.velocity is None
+                or any(tid not in velocities for tid in candidates)):
             return None
         dv = sorted((float(np.hypot(*(velocities[tid] - self.velocity))), tid) for tid in candidates)
         if dv[0][0] <= self._same_velocity and dv[1][0] > self._other_velocity:
