@@ -131,22 +131,19 @@ def test_of_several_in_front_the_one_walking_on_as_the_person_walked_takes_their
     walking = np.array([1.0, 0.0])  # m/s, world frame: the person walked on ahead of the robot
     person, passer_by = np.array([2.0, 0.1]), np.array([1.6, -0.5])  # both in the zone ahead
 
-    def relock(person_v, passer_v, seen_v=walking):
+    def relock(person_v, passer_v, seen_v=walking):  # velocities of None: none given
         sel = TargetSelector("auto", same_velocity_mps=0.2, other_velocity_mps=1.2)
         sel.target = 1
         sel.seen(0.0, np.array([1.5, 0.0]), seen_v)
         sel.lost(0.2)
-        return sel.reacquire(1.3, {7: person, 8: passer_by}, {7: person_v, 8: passer_v})
+        velocities = None if person_v is None else {7: person_v, 8: passer_v}
+        return sel.reacquire(1.3, {7: person, 8: passer_by}, velocities)
 
     assert relock(np.array([1.1, 0.1]), np.array([-1.0, 0.3])) == 7  # the passer-by comes the other way
     assert relock(np.array([1.1, 0.1]), np.array([0.3, 0.9])) is None  # crossing at 1.1 m/s from their walk: unsure
     assert relock(np.array([1.5, 0.0]), np.array([-1.0, 0.3])) is None  # neither walks as the person did
     assert relock(np.array([1.1, 0.1]), np.array([-1.0, 0.3]), seen_v=None) is None  # their walk is not known
-    sel = TargetSelector("auto")
-    sel.target = 1
-    sel.seen(0.0, np.array([1.5, 0.0]), walking)
-    sel.lost(0.2)
-    assert sel.reacquire(1.3, {7: person, 8: passer_by}) is None  # no velocities given: nobody
+    assert relock(None, None) is None  # no velocities given: nobody
 
 
 def test_two_tracks_in_front_closer_than_two_people_can_stand_are_one_person():
