@@ -139,6 +139,7 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
     state = {"index": 0, "dropped": 0, "last_drop_warn": -math.inf, "last_scan": None, "silent_warned": False,
              "stop": False, "processed": 0}
     latencies: list[float] = []
+    work_times: list[float] = []  # s: from taking the scan off the queue to people published (no waiting)
     reliable = QoSProfile(depth=50)
     pub_people = node.create_publisher(PoseArray, "people", reliable)
     pub_markers = node.create_publisher(MarkerArray, "people_markers", reliable)
@@ -228,6 +229,7 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
         return out
 
     def process(item: _Pending) -> None:
+        started = time.perf_counter()
         msg = item.msg
         scan, problem = item.decoded()
         pose = pose_last = None
@@ -252,7 +254,9 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
             yaw = math.atan2(t.vy, t.vx) if math.hypot(t.vx, t.vy) > 1e-6 else 0.0
             people.poses.append(Pose(position=Point(x=t.x, y=t.y, z=0.0), orientation=_quaternion(yaw)))
         pub_people.publish(people)
-        latencies.append(time.perf_counter() - item.received)
+        published = time.perf_counter()
+        latencies.append(published - item.received)
+        work_times.append(published - started)
         pub_markers.publish(markers(msg.header.stamp, tracks))
         target = next((t for t in tracks if t.target), None)
         if target is not None:
@@ -321,7 +325,9 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
         node.destroy_node()
         rclpy.try_shutdown()
     timing = (f"latency (scan received -> people published) p50 {_percentile_ms(latencies, 50):.2f} ms, "
-              f"p99 {_percentile_ms(latencies, 99):.2f} ms" if latencies else "no scan arrived")
+              f"p99 {_percentile_ms(latencies, 99):.2f} ms; of it tracking the scan p50 "
+              f"{_percentile_ms(work_times, 50):.2f} ms, p99 {_percentile_ms(work_times, 99):.2f} ms"
+              if latencies else "no scan arrived")
     print(f"people-tracker ros2: {state['processed']} scans tracked, {state['dropped']} dropped; {timing}", flush=True)
     return 0
 

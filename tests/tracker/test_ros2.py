@@ -104,7 +104,7 @@ def test_the_node_publishes_what_the_offline_run_writes(tmp_path, moving_bag):
     # SIGINT: a normal shutdown, not the kill after 10 s (the margin: a 2-core machine running the
     # other tests beside it took 1.5 s or more once in three runs)
     assert code == 0 and took < 5.0, (code, took, err)
-    assert "873 scans tracked, 0 dropped" in out and "p50" in out and "p99" in out, out
+    assert "873 scans tracked, 0 dropped" in out and "p50" in out and "p99" in out and "of it tracking the scan" in out, out
     heard = json.loads((tmp_path / "heard.json").read_text())
     live = {(round(s, 6), i): (x, y) for s, i, x, y in heard["rows"]}
     with offline.open() as fh:
