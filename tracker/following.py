@@ -13,12 +13,15 @@ robot follows whoever it locked onto in front of it) gives a lost person's id in
 the one person in front of the robot after a moment, if there is exactly one (of several,
 the one clearly walking as the person last walked, by their world-frame velocity): a robot
 following someone has them in front of it, wherever a drifting or turned estimate says
-they went, and the one track near that estimate was more often a passer-by than them.
+they went, and the one track near that estimate was more often a passer-by than them. A
+track that walks neither as the person last walked nor as the robot that follows them now
+moves is a passer-by, not them, and takes no id.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 
 import numpy as np
 
@@ -54,7 +57,14 @@ class TargetSelector:
         the re-lock began (:meth:`looked_for`): the robot may have fallen back. With several
         there, the one walking as the person last walked takes the id, when it is clearly
         them: its world-frame velocity within ``same_velocity_mps`` (m/s) of theirs and every
-        other's more than ``other_velocity_mps`` from it (:meth:`_walking_on`).
+        other's more than ``other_velocity_mps`` from it (:meth:`_walking_on`). Whoever is
+        chosen must walk as the person could (:meth:`walks_as_expected`).
+    max_walk_change_mps, sensor_velocity_s : float
+        A track re-locked onto walks (world-frame velocity) within ``max_walk_change_mps``
+        (m/s) of the person's velocity when last seen, or of the sensor's own velocity over
+        the last ``sensor_velocity_s`` seconds (a robot following someone moves as they do,
+        turns after them included); else it is someone coming the other way or crossing,
+        and the person stays lost. None: no such test.
     same_person_m : float
         Reported tracks in the zone ahead all within this distance (m) of the closest of
         them are one person seen twice (a track on each leg), not several people: the
@@ -73,7 +83,8 @@ class TargetSelector:
                  ahead_deg: float = 60.0, lock_range_m: float = 3.5, walk_mps: float = 1.5,
                  coast_s: float = 0.5, max_reach_m: float = 4.0, steady_s: float = 1.5,
                  slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35,
-                 lane_m: float = 0.75, same_velocity_mps: float = 0.2, other_velocity_mps: float = 1.2) -> None:
+                 lane_m: float = 0.75, same_velocity_mps: float = 0.2, other_velocity_mps: float = 1.2,
+                 max_walk_change_mps: float | None = 1.0, sensor_velocity_s: float = 0.5) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
@@ -91,6 +102,9 @@ class TargetSelector:
         self.velocity: np.ndarray | None = None  # the person's velocity when last seen (world frame, m/s)
         self._same_velocity, self._other_velocity = same_velocity_mps, other_velocity_mps
         self.events: list[str] = []
+        self._max_walk_change = max_walk_change_mps
+        self._path_s = sensor_velocity_s
+        self._path: deque = deque()  # (stamp s, x m, y m): the sensor's place in the world frame, lately
 
     def seen(self, stamp: float, q: np.ndarray, velocity: np.ndarray | None = None) -> None:
         """The target's track was updated at ``stamp`` (s), at ``q`` in the sensor frame (m),
@@ -109,6 +123,34 @@ class TargetSelector:
             self.steady = q.copy()
         self._q, self._t, self._yaw = q.copy(), stamp, self.yaw
         self.lost_since = None
+
+    def moved(self, stamp: float, x: float, y: float) -> None:
+        """The sensor is at ``(x, y)`` (world frame, m) at ``stamp`` (s)."""
+        self._path.append((stamp, x, y))
+        while len(self._path) > 2 and stamp - self._path[1][0] >= self._path_s:
+            self._path.popleft()
+
+    def forget_path(self) -> None:
+        """Forget where the sensor was (the scan history restarts)."""
+        self._path.clear()
+
+    def sensor_velocity(self) -> np.ndarray | None:
+        """The sensor's velocity over the last ``sensor_velocity_s`` (world frame, m/s), or None."""
+        if len(self._path) < 2:
+            return None
+        (t0, x0, y0), (t1, x1, y1) = self._path[0], self._path[-1]
+        if t1 - t0 < 0.5 * self._path_s:
+            return None
+        return np.array([(x1 - x0) / (t1 - t0), (y1 - y0) / (t1 - t0)])
+
+    def walks_as_expected(self, velocity: np.ndarray | None) -> bool:
+        """Whether a track walking at ``velocity`` (world frame, m/s) could be the person: within
+        ``max_walk_change_mps`` of how they last walked or of how the sensor that follows them
+        moves now (True when neither, or the velocity, is known)."""
+        if self._max_walk_change is None or velocity is None:
+            return True
+        refs = [r for r in (self.velocity, self.sensor_velocity()) if r is not None]
+        return not refs or min(float(np.hypot(*(velocity - r))) for r in refs) <= self._max_walk_change
 
     def lost(self, stamp: float) -> None:
         """The target's track broke off (or was found on someone else) at ``stamp`` (s)."""
@@ -171,6 +213,8 @@ class TargetSelector:
             best = self._first(looked, others, only=True)
             if best is None:
                 best = self._walking_on(looked, velocities)
+            if best is not None and velocities is not None and not self.walks_as_expected(velocities.get(best)):
+                best = None  # walking as neither the person nor the robot that follows them: a passer-by
             if best is not None:  # where they are now is learnt afresh
                 self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
         else:

@@ -161,6 +161,8 @@ class PeopleTracker:
         self.aligner.reset()
         self.standing.reset()
         self.places.reset()
+        if self.selector is not None:
+            self.selector.forget_path()  # the world frame may start anew: no velocity across the jump
 
     def step(self, scan: Scan, pose: Pose2D | None = None, pose_last_beam: Pose2D | None = None) -> list[Track]:
         """Process one scan; return the confirmed tracks (coasting ones included).
@@ -750,6 +752,7 @@ class PeopleTracker:
             return None
         inv = world.inverse()
         sel.yaw = world.yaw
+        sel.moved(stamp, world.x, world.y)
 
         def here(tracks) -> dict[int, np.ndarray]:  # id -> place in the sensor frame (m)
             return {u.track_id: inv.transform_points(u.position[None])[0] for u in tracks}

@@ -146,6 +146,27 @@ def test_of_several_in_front_the_one_walking_on_as_the_person_walked_takes_their
     assert relock(None, None) is None  # no velocities given: nobody
 
 
+def test_the_one_in_front_is_not_taken_when_they_walk_as_neither_the_person_nor_the_robot():
+    def relock(velocity, robot_turns=False):
+        """The person walked ahead at 1 m/s along x with the robot behind them, was lost at
+        0.6 s; at 1.7 s one track is in front, walking at ``velocity`` (world frame, m/s)."""
+        sel = TargetSelector("auto", max_walk_change_mps=1.0, sensor_velocity_s=0.5)
+        sel.target = 1
+        for k in range(18):  # the robot drives at 1 m/s: along x, or (``robot_turns``) along y from 0.6 s on
+            t = 0.1 * k
+            sel.moved(t, min(t, 0.6) if robot_turns else t, max(t - 0.6, 0.0) if robot_turns else 0.0)
+            if k == 5:
+                sel.seen(t, np.array([2.0, 0.0]), np.array([1.0, 0.0]))
+        sel.lost(0.6)
+        return sel.reacquire(1.7, {7: np.array([1.8, 0.2])}, None if velocity is None else {7: velocity})
+
+    assert relock(np.array([1.1, 0.2])) == 7  # walks on as the person walked
+    assert relock(np.array([-1.0, 0.3])) is None  # comes the other way, towards the robot: a passer-by
+    assert relock(np.array([0.2, 1.1])) is None  # crossing: neither the person's walk nor the robot's
+    assert relock(np.array([0.2, 1.1]), robot_turns=True) == 7  # the person turned, and the robot after them
+    assert relock(None) == 7  # no velocities given: the one in front, as before
+
+
 def test_two_tracks_in_front_closer_than_two_people_can_stand_are_one_person():
     sel = TargetSelector("auto", same_person_m=0.35)
     sel.target = 1
