@@ -10,7 +10,7 @@ every scan where the person is visible, after the first lock, into: the target i
 track is on them (the tracker has them, the target model gave the id to no one: lost for
 less than ``relock_s``, or after it, how many reported tracks lay where the re-lock looks
 for the person, the zone ahead and beyond it where they could be: with two or more the id
-goes to none);
+goes to none, and one that walks as the person could not takes no id either);
 no target while only an unreported track is on them; no target and no track near them.
 The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
 """
@@ -57,8 +57,9 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
                 why = f"lost for less than {sel.relock_s:g} s"
             else:
                 ahead = len(sel.looked_for(stamp, here))
-                why = "they are not where the re-lock looks" if ahead == 0 else \
-                    f"{min(ahead, 3)}{'+' if ahead >= 3 else ''} reported tracks where the re-lock looks"
+                why = ("they are not where the re-lock looks" if ahead == 0 else
+                       "1 reported track where the re-lock looks, walking as the person could not" if ahead == 1 else
+                       f"{min(ahead, 3)}{'+' if ahead >= 3 else ''} reported tracks where the re-lock looks")
             out[f"no target, a reported track on them: {why}"] += 1
         elif any(float(np.hypot(*(q - truth.torso_sensor[k[0]]))) <= NEAR_M
                  for q in tracks_in_sensor_frame([u.report() for u in tracker._tracks], tracker.last.pose)):
