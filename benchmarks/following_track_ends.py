@@ -58,8 +58,8 @@ class _Traced:
             traced.updates[id(track)].append((traced.scan, step, np.array(z, dtype=float)))
             return update(track, z, R, moving)
 
-        def traced_recover(tracker, candidates, matched):
-            out = recover(tracker, candidates, matched)
+        def traced_recover(tracker, candidates, matched, *rest):
+            out = recover(tracker, candidates, matched, *rest)
             traced.recovered = {id(tracker._tracks[ti]) for ti, _ in out}
             return out
 
