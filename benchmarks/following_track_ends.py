@@ -33,6 +33,7 @@ from people_tracker.tracker import people_tracker as P  # noqa: E402
 from people_tracker.tracker import tracks as T  # noqa: E402
 from people_tracker.tracker.config import load_config  # noqa: E402
 from people_tracker.tracker.io.simulated import SimulatedSource  # noqa: E402
+from people_tracker.tracker.people_tracker import tracks_in_sensor_frame  # noqa: E402
 
 ON_M = 0.5  # m: a measurement this close to a person was made of them
 STEPS = {"associate": "a moving candidate (association)", "recover": "a moving candidate (re-join of a turn)",
@@ -47,7 +48,8 @@ class _Traced:
         self.recovered: set[int] = set()
         self.updates: dict[int, list] = defaultdict(list)  # id(TrackState) -> updates
 
-    def install(self) -> None:
+    def install(self):
+        """Wrap the tracker's methods; returns a function that puts them back."""
         update, recover = T.TrackState.update, P.PeopleTracker._recover
         traced = self
 
@@ -65,10 +67,21 @@ class _Traced:
 
         T.TrackState.update, P.PeopleTracker._recover = traced_update, traced_recover
 
+        def uninstall() -> None:
+            T.TrackState.update, P.PeopleTracker._recover = update, recover
+        return uninstall
+
 
 def classify(scene: str, laser: str, seed: int, duration: float | None) -> Counter:
     traced = _Traced()
-    traced.install()
+    uninstall = traced.install()
+    try:
+        return _classify(traced, scene, laser, seed, duration)
+    finally:
+        uninstall()  # a second run in this process wraps the tracker's own methods, not these
+
+
+def _classify(traced: _Traced, scene: str, laser: str, seed: int, duration: float | None) -> Counter:
     source = SimulatedSource(scene, seed=seed, duration=duration, laser=laser)
     tracker = P.PeopleTracker.from_config(load_config(), follow="auto")
     truths, poses, counts = [], [], Counter()
@@ -83,9 +96,9 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
         if not truth.visible[k]:
             on_person = None
             continue
-        inv = tracker.last.pose.inverse()
-        near = [(float(np.hypot(*(inv.transform_points(t.position[None])[0] - truth.torso_sensor[k]))), id(t), t)
-                for t in tracker._tracks if t.reported]
+        reported = [t for t in tracker._tracks if t.reported]
+        q = tracks_in_sensor_frame([t.report() for t in reported], tracker.last.pose)
+        near = [(float(np.hypot(*(qt - truth.torso_sensor[k]))), id(t), t) for t, qt in zip(reported, q)]
         near = [n for n in near if n[0] <= NEAR_M]
         if near:
             on_person = min(near)[2]
