@@ -81,7 +81,8 @@ class PersonCandidate:
     sigma : float
         Standard deviation of that position, metres (isotropic).
     kind : str
-        ``pair``, ``leg``, ``blob`` (from moving objects) or ``static`` (static support).
+        ``pair``, ``leg``, ``blob`` (from moving objects), ``static`` (static support) or
+        ``receding`` (a walker's revealed readings, ``association.receding``).
     object_ids : tuple of int
         The moving objects it was made from.
     legs : tuple of (float, float)

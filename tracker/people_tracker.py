@@ -18,6 +18,7 @@ import numpy as np
 
 from people_tracker.detection.align import Alignment, AlignParams, ScanAligner
 from people_tracker.detection.detector import Detection, DetectorParams, MovingObjectDetector
+from people_tracker.detection import labels as L
 from people_tracker.detection.free_space import (OCCLUDED, SEEN_THROUGH, UNSEEN, PlaceMemory, place_visibility,
                                                  seen_through)
 from people_tracker.detection.leg_features import LegCandidates, leg_candidates
@@ -63,6 +64,12 @@ class AssociationParams:
         track even where no earlier scan saw the place empty: someone walking straight away
         from a robot that follows them stays in their own shadow, and outdoors nothing
         behind them returns a reading to see past.
+    receding : bool
+        A confirmed walking track moving away from the laser at ``PASSING_MPS`` or faster
+        may take, as a moving candidate, a person-sized group of the readings at its
+        prediction that belong to no moving object and hold at least
+        ``support_min_points`` readings the detector labelled ``OCCLUDED`` (see
+        :meth:`PeopleTracker._receding`).
     """
 
     method: str = "gnn"
@@ -76,6 +83,7 @@ class AssociationParams:
     free_space_margin_m: float = 0.3
     recover_radius_m: float = 0.8
     start_leg_probability: float = 0.5
+    receding: bool = False
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,6 +199,7 @@ class PeopleTracker:
         legs = leg_candidates(scan)  # every leg candidate and its probability, by shape alone
         leg_scores = self.leg_model.probability(legs.features)
         candidates = self._candidates(detection, world, legs, leg_scores)  # 3. legs paired into people (world frame)
+        candidates += self._receding(detection, scan, world)  # 3b. walkers in their own shadow
         matched = self._associate(candidates)  # 4. associate candidates to tracks
         matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
         for ti, ci in matched:  # 5. update the matched tracks
@@ -453,6 +462,47 @@ class PeopleTracker:
                                      candidates[k].object_ids)
         return out
 
+    def _receding(self, detection: Detection, scan: Scan, world: Pose2D) -> list[PersonCandidate]:
+        """Candidates (world frame, kind ``receding``) for walkers moving away from the laser.
+
+        Someone walking straight away from the laser (a robot following them) is seen behind
+        where an earlier scan saw them, so the detector labels their readings revealed
+        (``OCCLUDED``), not moving, and their legs often give no moving object; a passer-by
+        coming the other way beside them does, and would take their track. For each
+        confirmed walking track whose velocity points away from the sensor at ``PASSING_MPS``
+        or faster, a person-sized group of the readings at its prediction (no moving
+        object's; as static support finds it) holding at least ``support_min_points``
+        revealed readings is a candidate, with a single leg's σ; not where the place memory
+        only ever saw the place occupied (furniture). These candidates start no track and
+        re-join no turn (``association.receding``; off by default)."""
+        if not self.assoc.receding:
+            return []
+        walkers = [t for t in self._tracks if t.confirmed and t.moved and not t.still]
+        if walkers:  # walking away from the laser: only then is a walker revealed behind where they were
+            sensor = np.array([world.x, world.y])
+            away = [float(np.dot(t.velocity, t.position - sensor)) / max(float(np.hypot(*(t.position - sensor))), 1e-6)
+                    for t in walkers]
+            walkers = [t for t, v in zip(walkers, away) if v >= PASSING_MPS]
+        if not walkers:
+            return []
+        in_objects = np.zeros(scan.n_beams, dtype=bool)
+        for o in detection.objects:
+            in_objects[o.beams] = True
+        d = self.detector.params
+        found = static_support(np.array([t.position for t in walkers]), world, scan, d.k_segment,
+                               d.segment_floor_m, self.assoc.support_radius_m, self.pairing.max_person_size_m,
+                               self.assoc.support_min_points, self.pairing.max_leg_radius_m, in_objects,
+                               detection.labels == L.OCCLUDED)
+        out, seen = [], set()
+        for z in found:
+            if z is None or (round(z[0], 6), round(z[1], 6)) in seen:
+                continue
+            if self._place_history(z, scan.stamp) == PlaceMemory.OCCUPIED_ONLY:
+                continue  # furniture: only ever seen occupied
+            seen.add((round(z[0], 6), round(z[1], 6)))
+            out.append(PersonCandidate(float(z[0]), float(z[1]), self.pairing.sigma_single_leg_m, "receding"))
+        return out
+
     def _associate(self, candidates: list[PersonCandidate]) -> list[tuple[int, int]]:
         if not self._tracks or not candidates:
             return []
@@ -519,7 +569,7 @@ class PeopleTracker:
         frame, m) to the nearest, one each; those tracks forget their velocity. A candidate
         lying nearer another track (where it is now) than the idle track's anchor is that
         other track's: a passer-by's second leg, not the lost person turning."""
-        free = [k for k in range(len(candidates)) if k not in taken_c]
+        free = [k for k in range(len(candidates)) if k not in taken_c and candidates[k].kind != "receding"]
         if not idle or not free:
             return []
         z = np.array([(candidates[k].x, candidates[k].y) for k in free])
@@ -660,6 +710,7 @@ class PeopleTracker:
             self._next_id += 1
 
     def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float) -> None:
+        used = used | {ci for ci, c in enumerate(candidates) if c.kind == "receding"}
         fresh = [ci for ci in range(len(candidates)) if ci not in used]
         free = np.ones(len(candidates), dtype=bool)
         if fresh and self.assoc.free_space_lookback_s > 0:

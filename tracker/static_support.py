@@ -23,7 +23,8 @@ from people_tracker.tracker.pairing import leg_centres
 def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_segment: float,
                    segment_floor_m: float, radius_m: float, max_size_m: float,
                    min_points: int, max_leg_radius_m: float = 0.0,
-                   explained: np.ndarray | None = None) -> list[np.ndarray | None]:
+                   explained: np.ndarray | None = None,
+                   needed: np.ndarray | None = None) -> list[np.ndarray | None]:
     """For each predicted position (world frame, m), a supporting position or None.
 
     Parameters
@@ -48,6 +49,8 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
     explained : ndarray of bool, shape (n_beams,), optional
         Readings another person's moving candidate took this scan: they support nobody
         else (a passer-by's leg beside someone standing must not pull them along).
+    needed : ndarray of bool, shape (n_beams,), optional
+        A group must hold at least ``min_points`` of these readings.
     """
     out: list[np.ndarray | None] = [None] * len(predictions_world)
     if len(predictions_world) == 0 or scan.n_valid == 0:
@@ -72,6 +75,8 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         p = pts[members]
         extent = np.hypot(*np.ptp(p, axis=0)) if len(p) else 0.0
         if len(p) < min_points or extent > max_size_m:
+            continue
+        if needed is not None and np.count_nonzero(needed[valid][members]) < min_points:
             continue
         centre = p.mean(axis=0, keepdims=True)
         if max_leg_radius_m > 0:

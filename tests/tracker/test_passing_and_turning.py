@@ -403,3 +403,42 @@ def test_following_starts_with_the_person_in_the_robots_way():
     sel.lost(1.0)
     assert sel.reacquire(11.5, {}) is None and sel.target is None  # gone for good (reacquire_s)
     assert sel.choose({**aside, 5: np.array([2.5, 1.2])}) == 2  # then whoever comes back closest ahead
+
+
+def test_static_support_can_require_readings_of_a_kind():
+    scan = _scan([[3.0, 0.0, 0.06], [3.0, -0.2, 0.06]])
+    place = np.array([[3.0, -0.1]])
+    angles = scan.angle_min + scan.angle_increment * np.arange(scan.n_beams)
+    one_leg = np.abs(angles - math.atan2(0.0, 3.0)) < 0.02  # the readings of the leg at y = 0
+    found = static_support(place, Pose2D(), scan, 12.0, 0.06, 0.35, 0.8, 3, needed=one_leg)[0]
+    assert found is not None and abs(found[1] + 0.1) < 0.03  # both legs' readings give the place
+    assert one_leg.sum() >= 3 and static_support(place, Pose2D(), scan, 12.0, 0.06, 0.35, 0.8, 3,
+                                                  needed=np.zeros(scan.n_beams, dtype=bool))[0] is None
+
+
+def _walker_at_legs(velocity, receding=True):  # association.receding is off by default
+    """A tracker with one confirmed walking track at two legs 3 m ahead of the laser, whose
+    readings the detector labelled revealed (OCCLUDED), and the candidates it makes of them."""
+    from people_tracker.detection.detector import Detection
+    from people_tracker.detection.labels import OCCLUDED
+    from people_tracker.tracker.existence import Existence, ExistenceParams
+    from people_tracker.tracker.people_tracker import AssociationParams
+    from people_tracker.tracker.tracks import TrackParams, TrackState
+    scan = _scan([[3.0, 0.0, 0.06], [3.0, -0.2, 0.06]])
+    trk = PeopleTracker(association=AssociationParams(receding=receding))
+    t = TrackState(1, 3.0, -0.1, np.eye(2) * 0.01, 0.0, TrackParams(),
+                   Existence(ExistenceParams(), 0.0, False, True, None, 0.15))
+    t.confirmed = True
+    t.kf.x[1], t.kf.x[3] = velocity
+    trk._tracks = [t]
+    labels = np.where(scan.valid, OCCLUDED, 0).astype(np.int8)
+    return trk._receding(Detection(labels, [], (0.1,)), scan, Pose2D())
+
+
+def test_a_walker_receding_in_their_own_shadow_is_found_in_their_revealed_readings():
+    away = _walker_at_legs((1.0, 0.0))  # walking away from the laser (at the origin, facing +x)
+    assert len(away) == 1 and away[0].kind == "receding"
+    assert abs(away[0].x - 3.0) < 0.05 and abs(away[0].y + 0.1) < 0.05
+    assert _walker_at_legs((-1.0, 0.0)) == []  # coming towards the laser: never in their own shadow
+    assert _walker_at_legs((0.0, 1.0)) == []  # crossing the beams
+    assert _walker_at_legs((1.0, 0.0), receding=False) == []
