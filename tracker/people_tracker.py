@@ -205,7 +205,7 @@ class PeopleTracker:
         for ti, ci in matched:  # 5. update the matched tracks
             c = candidates[ci]
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
-        self._explained = self._explained_readings(detection, [candidates[ci] for _, ci in matched], scan.n_beams)
+        self._explained = self._object_readings(detection, {i for _, ci in matched for i in candidates[ci].object_ids})
         self._unmatchable_legs(scan, legs, leg_scores)  # 6. leg-shaped readings
         self._legs_world = world.transform_points(legs.xy) if len(legs.xy) else np.zeros((0, 2))
         self._leg_scores = leg_scores
@@ -225,12 +225,11 @@ class PeopleTracker:
         return reported
 
     @staticmethod
-    def _explained_readings(detection: Detection, used: list[PersonCandidate], n_beams: int) -> np.ndarray:
-        """The readings (per beam) of the moving objects that candidates given to tracks were made of."""
-        mask = np.zeros(n_beams, dtype=bool)
-        ids = {i for c in used for i in c.object_ids}
+    def _object_readings(detection: Detection, ids: set[int] | None = None) -> np.ndarray:
+        """The readings (per beam) of the moving objects with these ids (None: of every one)."""
+        mask = np.zeros(detection.labels.shape, dtype=bool)
         for o in detection.objects:
-            if o.object_id in ids:
+            if ids is None or o.object_id in ids:
                 mask[o.beams] = True
         return mask
 
@@ -425,10 +424,7 @@ class PeopleTracker:
         keep = leg_scores >= self.assoc.start_leg_probability
         if not lone or not keep.any() or not walking:
             return candidates
-        moving = np.zeros(detection.labels.shape, dtype=bool)
-        for o in detection.objects:
-            moving[o.beams] = True
-        still = keep & ~legs.touching(moving)
+        still = keep & ~legs.touching(self._object_readings(detection))
         if not still.any():
             return candidates
         widths = legs.features[still, 1]
@@ -485,14 +481,8 @@ class PeopleTracker:
             walkers = [t for t, v in zip(walkers, away) if v >= PASSING_MPS]
         if not walkers:
             return []
-        in_objects = np.zeros(scan.n_beams, dtype=bool)
-        for o in detection.objects:
-            in_objects[o.beams] = True
-        d = self.detector.params
-        found = static_support(np.array([t.position for t in walkers]), world, scan, d.k_segment,
-                               d.segment_floor_m, self.assoc.support_radius_m, self.pairing.max_person_size_m,
-                               self.assoc.support_min_points, self.pairing.max_leg_radius_m, in_objects,
-                               detection.labels == L.OCCLUDED)
+        found = self._static_support(np.array([t.position for t in walkers]), scan, world,
+                                     self._object_readings(detection), detection.labels == L.OCCLUDED)
         out, seen = [], set()
         for z in found:
             if z is None or (round(z[0], 6), round(z[1], 6)) in seen:
@@ -583,12 +573,17 @@ class PeopleTracker:
             self._tracks[idle[a]].forget_velocity()
         return [(idle[a], free[b]) for a, b in pairs]
 
-    def _static_support(self, places: np.ndarray, scan: Scan, world: Pose2D) -> list[np.ndarray | None]:
-        """A person-sized group of this scan's readings near each place (world frame), or None."""
+    def _static_support(self, places: np.ndarray, scan: Scan, world: Pose2D, explained: np.ndarray | None = None,
+                        needed: np.ndarray | None = None) -> list[np.ndarray | None]:
+        """A person-sized group of this scan's readings near each place (world frame), or None;
+        without the readings of ``explained`` (per beam; default: those of the moving
+        candidates given to tracks this scan), and holding ``needed`` ones if given (see
+        :func:`static_support`)."""
         d = self.detector.params
         return static_support(places, world, scan, d.k_segment, d.segment_floor_m, self.assoc.support_radius_m,
                               self.pairing.max_person_size_m, self.assoc.support_min_points,
-                              self.pairing.max_leg_radius_m, self._explained)
+                              self.pairing.max_leg_radius_m, self._explained if explained is None else explained,
+                              needed)
 
     def _clear_of_tracks(self, xy: np.ndarray) -> np.ndarray:
         """Whether each place (world frame) is at least ``spawn_exclusion_m`` from every track."""
