@@ -199,7 +199,7 @@ class PeopleTracker:
         legs = leg_candidates(scan)  # every leg candidate and its probability, by shape alone
         leg_scores = self.leg_model.probability(legs.features)
         candidates = self._candidates(detection, world, legs, leg_scores)  # 3. legs paired into people (world frame)
-        candidates += self._receding(detection, scan, world)  # 3b. walkers in their own shadow
+        candidates += self._receding(detection, scan, world, legs, leg_scores)  # 3b. walkers in their own shadow
         matched = self._associate(candidates)  # 4. associate candidates to tracks
         matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
         for ti, ci in matched:  # 5. update the matched tracks
@@ -458,7 +458,8 @@ class PeopleTracker:
                                      candidates[k].object_ids)
         return out
 
-    def _receding(self, detection: Detection, scan: Scan, world: Pose2D) -> list[PersonCandidate]:
+    def _receding(self, detection: Detection, scan: Scan, world: Pose2D, legs: LegCandidates,
+                  leg_scores: np.ndarray) -> list[PersonCandidate]:
         """Candidates (world frame, kind ``receding``) for walkers moving away from the laser.
 
         Someone walking straight away from the laser (a robot following them) is seen behind
@@ -468,9 +469,12 @@ class PeopleTracker:
         confirmed walking track whose velocity points away from the sensor at ``PASSING_MPS``
         or faster, a person-sized group of the readings at its prediction (no moving
         object's; as static support finds it) holding at least ``support_min_points``
-        revealed readings is a candidate, with a single leg's σ; not where the place memory
-        only ever saw the place occupied (furniture). These candidates start no track and
-        re-join no turn (``association.receding``; off by default)."""
+        revealed readings is a candidate, with a single leg's σ, when a leg candidate the leg
+        model finds at least ``standing.min_leg_probability`` leg-like lies within half a
+        person's size (``pairing.max_person_size_m``) of it: a surface seen at a grazing angle
+        behind a moving robot is revealed too, step by step, but has no leg's shape. Not where
+        the place memory only ever saw the place occupied (furniture). These candidates start
+        no track and re-join no turn (``association.receding``; off by default)."""
         if not self.assoc.receding:
             return []
         walkers = [t for t in self._tracks if t.confirmed and t.moved and not t.still]
@@ -483,10 +487,14 @@ class PeopleTracker:
             return []
         found = self._static_support(np.array([t.position for t in walkers]), scan, world,
                                      self._object_readings(detection), detection.labels == L.OCCLUDED)
+        leg_like = leg_scores >= self.standing.params.min_leg_probability
+        legs_w = world.transform_points(legs.xy[leg_like]) if leg_like.any() else np.zeros((0, 2))
         out, seen = [], set()
         for z in found:
             if z is None or (round(z[0], 6), round(z[1], 6)) in seen:
                 continue
+            if not len(legs_w) or np.hypot(*(legs_w - z).T).min() > self.pairing.max_person_size_m / 2:
+                continue  # nothing leg-shaped: a surface revealed at a grazing angle
             if self._place_history(z, scan.stamp) == PlaceMemory.OCCUPIED_ONLY:
                 continue  # furniture: only ever seen occupied
             seen.add((round(z[0], 6), round(z[1], 6)))

@@ -15,8 +15,9 @@ from people_tracker.tracker.static_support import static_support
 LASER = {"fov_deg": 270, "resolution_deg": 0.35, "rate_hz": 10, "range_max": 20, "noise_std": 0.0}
 
 
-def _scan(pillars):
-    sim, _ = build_simulation({"duration_s": 1, "laser": LASER, "world": {"room": [-1, -6, 6, 6], "pillars": pillars}})
+def _scan(pillars, walls=()):
+    sim, _ = build_simulation({"duration_s": 1, "laser": LASER,
+                               "world": {"room": [-1, -6, 6, 6], "pillars": pillars, "walls": list(walls)}})
     return sim.step().scan
 
 
@@ -416,15 +417,17 @@ def test_static_support_can_require_readings_of_a_kind():
                                                   needed=np.zeros(scan.n_beams, dtype=bool))[0] is None
 
 
-def _walker_at_legs(velocity, receding=True):  # association.receding is off by default
-    """A tracker with one confirmed walking track at two legs 3 m ahead of the laser, whose
-    readings the detector labelled revealed (OCCLUDED), and the candidates it makes of them."""
+def _walker_at_legs(velocity, receding=True, scan=None):  # association.receding is off by default
+    """A tracker with one confirmed walking track at two legs 3 m ahead of the laser (or at
+    whatever ``scan`` shows there), whose readings the detector labelled revealed (OCCLUDED),
+    and the candidates it makes of them."""
+    from people_tracker.detection.leg_features import leg_candidates
     from people_tracker.detection.detector import Detection
     from people_tracker.detection.labels import OCCLUDED
     from people_tracker.tracker.existence import Existence, ExistenceParams
     from people_tracker.tracker.people_tracker import AssociationParams
     from people_tracker.tracker.tracks import TrackParams, TrackState
-    scan = _scan([[3.0, 0.0, 0.06], [3.0, -0.2, 0.06]])
+    scan = _scan([[3.0, 0.0, 0.06], [3.0, -0.2, 0.06]]) if scan is None else scan
     trk = PeopleTracker(association=AssociationParams(receding=receding))
     t = TrackState(1, 3.0, -0.1, np.eye(2) * 0.01, 0.0, TrackParams(),
                    Existence(ExistenceParams(), 0.0, False, True, None, 0.15))
@@ -432,7 +435,8 @@ def _walker_at_legs(velocity, receding=True):  # association.receding is off by 
     t.kf.x[1], t.kf.x[3] = velocity
     trk._tracks = [t]
     labels = np.where(scan.valid, OCCLUDED, 0).astype(np.int8)
-    return trk._receding(Detection(labels, [], (0.1,)), scan, Pose2D())
+    legs = leg_candidates(scan)
+    return trk._receding(Detection(labels, [], (0.1,)), scan, Pose2D(), legs, trk.leg_model.probability(legs.features))
 
 
 def test_a_walker_receding_in_their_own_shadow_is_found_in_their_revealed_readings():
@@ -442,3 +446,10 @@ def test_a_walker_receding_in_their_own_shadow_is_found_in_their_revealed_readin
     assert _walker_at_legs((-1.0, 0.0)) == []  # coming towards the laser: never in their own shadow
     assert _walker_at_legs((0.0, 1.0)) == []  # crossing the beams
     assert _walker_at_legs((1.0, 0.0), receding=False) == []
+
+
+def test_a_revealed_surface_with_no_leg_shape_is_no_receding_walker():
+    # a wall seen edge-on at the track's place (a grazing surface behind a moving robot is
+    # revealed step by step too): its readings are revealed, but nothing there is leg-shaped
+    wall = _scan([], walls=[[2.8, -0.3, 3.4, 0.1]])
+    assert _walker_at_legs((1.0, 0.0), scan=wall) == []
