@@ -37,8 +37,8 @@ from people_tracker.tracker.config import load_config  # noqa: E402
 from people_tracker.tracker.io.recording import Recording  # noqa: E402
 from people_tracker.tracker.people_tracker import PeopleTracker, warm_up_kernels  # noqa: E402
 
-TRACKER_STAGES = ("_candidates", "_associate", "_recover", "_standing_candidates", "_update_standing", "_support",
-                  "_weigh", "_remember_standing", "_reacquire_standing", "_initiate", "_initiate_standing",
+TRACKER_STAGES = ("_candidates", "_receding", "_associate", "_recover", "_standing_candidates", "_update_standing",
+                  "_support", "_weigh", "_remember_standing", "_reacquire_standing", "_initiate", "_initiate_standing",
                   "_delete", "_follow", "_unmatchable_legs")
 DETECT, ALIGN = "detect: moving objects", "align: de-skew and scan matching"
 # (module or class, attribute, label, the stage it is part of): the detector's and the aligner's parts

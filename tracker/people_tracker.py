@@ -68,8 +68,8 @@ class AssociationParams:
         A confirmed walking track moving away from the laser at ``PASSING_MPS`` or faster
         may take, as a moving candidate, a person-sized group of the readings at its
         prediction that belong to no moving object and hold at least
-        ``support_min_points`` readings the detector labelled ``OCCLUDED`` (see
-        :meth:`PeopleTracker._receding`).
+        ``support_min_points`` readings the detector labelled ``OCCLUDED`` and lying by a
+        leg-shaped segment (see :meth:`PeopleTracker._receding`). On by default.
     """
 
     method: str = "gnn"
@@ -83,7 +83,7 @@ class AssociationParams:
     free_space_margin_m: float = 0.3
     recover_radius_m: float = 0.8
     start_leg_probability: float = 0.5
-    receding: bool = False
+    receding: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -474,7 +474,7 @@ class PeopleTracker:
         person's size (``pairing.max_person_size_m``) of it: a surface seen at a grazing angle
         behind a moving robot is revealed too, step by step, but has no leg's shape. Not where
         the place memory only ever saw the place occupied (furniture). These candidates start
-        no track and re-join no turn (``association.receding``; off by default)."""
+        no track and re-join no turn (``association.receding``)."""
         if not self.assoc.receding:
             return []
         walkers = [t for t in self._tracks if t.confirmed and t.moved and not t.still]

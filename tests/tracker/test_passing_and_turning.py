@@ -417,7 +417,7 @@ def test_static_support_can_require_readings_of_a_kind():
                                                   needed=np.zeros(scan.n_beams, dtype=bool))[0] is None
 
 
-def _walker_at_legs(velocity, receding=True, scan=None):  # association.receding is off by default
+def _walker_at_legs(velocity, receding=True, scan=None):
     """A tracker with one confirmed walking track at two legs 3 m ahead of the laser (or at
     whatever ``scan`` shows there), whose readings the detector labelled revealed (OCCLUDED),
     and the candidates it makes of them."""
