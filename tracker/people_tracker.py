@@ -198,8 +198,10 @@ class PeopleTracker:
             t.predict(scan.stamp)
         legs = leg_candidates(scan)  # every leg candidate and its probability, by shape alone
         leg_scores = self.leg_model.probability(legs.features)
+        self._legs_world = world.transform_points(legs.xy) if len(legs.xy) else np.zeros((0, 2))
+        self._leg_scores = leg_scores
         candidates = self._candidates(detection, world, legs, leg_scores)  # 3. legs paired into people (world frame)
-        candidates += self._receding(detection, scan, world, legs, leg_scores)  # 3b. walkers in their own shadow
+        candidates += self._receding(detection, scan, world)  # 3b. walkers in their own shadow
         matched = self._associate(candidates)  # 4. associate candidates to tracks
         matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
         for ti, ci in matched:  # 5. update the matched tracks
@@ -207,8 +209,6 @@ class PeopleTracker:
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
         self._explained = self._object_readings(detection, {i for _, ci in matched for i in candidates[ci].object_ids})
         self._unmatchable_legs(scan, legs, leg_scores)  # 6. leg-shaped readings
-        self._legs_world = world.transform_points(legs.xy) if len(legs.xy) else np.zeros((0, 2))
-        self._leg_scores = leg_scores
         standing = self._standing_candidates(scan, legs, leg_scores, world)  # 6b. standing people: leg pairs
         matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
         self._support(scan, world, matched_t)  # 7. static support for the rest
@@ -242,13 +242,13 @@ class PeopleTracker:
                 mask[a:b] = True
             self.aligner.exclude_from_reference(mask)
 
-    def _best_leg(self, xy_world: np.ndarray) -> np.ndarray:
-        """The best leg probability among this scan's leg candidates within the support
-        radius of each place (world frame); nan where there is none."""
+    def _best_leg(self, xy_world: np.ndarray, radius_m: float | None = None) -> np.ndarray:
+        """The best leg probability among this scan's leg candidates within ``radius_m``
+        (default: the support radius) of each place (world frame); nan where there is none."""
         out = np.full(len(xy_world), np.nan)
         if len(xy_world) and len(self._legs_world):
             d = pairwise_distances(xy_world, self._legs_world)
-            near = d <= self.assoc.support_radius_m
+            near = d <= (self.assoc.support_radius_m if radius_m is None else radius_m)
             scores = np.where(near, self._leg_scores[None, :], -1.0).max(axis=1)
             out = np.where(near.any(axis=1), scores, np.nan)
         return out
@@ -458,8 +458,7 @@ class PeopleTracker:
                                      candidates[k].object_ids)
         return out
 
-    def _receding(self, detection: Detection, scan: Scan, world: Pose2D, legs: LegCandidates,
-                  leg_scores: np.ndarray) -> list[PersonCandidate]:
+    def _receding(self, detection: Detection, scan: Scan, world: Pose2D) -> list[PersonCandidate]:
         """Candidates (world frame, kind ``receding``) for walkers moving away from the laser.
 
         Someone walking straight away from the laser (a robot following them) is seen behind
@@ -487,13 +486,12 @@ class PeopleTracker:
             return []
         found = self._static_support(np.array([t.position for t in walkers]), scan, world,
                                      self._object_readings(detection), detection.labels == L.OCCLUDED)
-        leg_like = leg_scores >= self.standing.params.min_leg_probability
-        legs_w = world.transform_points(legs.xy[leg_like]) if leg_like.any() else np.zeros((0, 2))
         out, seen = [], set()
         for z in found:
             if z is None or (round(z[0], 6), round(z[1], 6)) in seen:
                 continue
-            if not len(legs_w) or np.hypot(*(legs_w - z).T).min() > self.pairing.max_person_size_m / 2:
+            leg = self._best_leg(z[None], self.pairing.max_person_size_m / 2)[0]
+            if not leg >= self.standing.params.min_leg_probability:  # nan: no leg candidate near
                 continue  # nothing leg-shaped: a surface revealed at a grazing angle
             if self._place_history(z, scan.stamp) == PlaceMemory.OCCUPIED_ONLY:
                 continue  # furniture: only ever seen occupied

@@ -63,6 +63,7 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
     pred_sensor = pose.inverse().transform_points(predictions_world)
     d = pairwise_distances(pred_sensor, pts)
     free = np.ones(len(valid), dtype=bool) if explained is None else ~explained[valid]
+    needed_valid = None if needed is None else needed[valid]  # per valid reading, as ``free``
     d[:, ~free] = np.inf
     chosen = np.zeros(len(bounds) - 1, dtype=bool)
     for t in range(len(pred_sensor)):
@@ -76,7 +77,7 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         extent = np.hypot(*np.ptp(p, axis=0)) if len(p) else 0.0
         if len(p) < min_points or extent > max_size_m:
             continue
-        if needed is not None and np.count_nonzero(needed[valid][members]) < min_points:
+        if needed_valid is not None and np.count_nonzero(needed_valid[members]) < min_points:
             continue
         centre = p.mean(axis=0, keepdims=True)
         if max_leg_radius_m > 0:

@@ -435,8 +435,9 @@ def _walker_at_legs(velocity, receding=True, scan=None):
     t.kf.x[1], t.kf.x[3] = velocity
     trk._tracks = [t]
     labels = np.where(scan.valid, OCCLUDED, 0).astype(np.int8)
-    legs = leg_candidates(scan)
-    return trk._receding(Detection(labels, [], (0.1,)), scan, Pose2D(), legs, trk.leg_model.probability(legs.features))
+    legs = leg_candidates(scan)  # the step keeps them (world frame: here the sensor's) for _receding
+    trk._legs_world, trk._leg_scores = legs.xy, trk.leg_model.probability(legs.features)
+    return trk._receding(Detection(labels, [], (0.1,)), scan, Pose2D())
 
 
 def test_a_walker_receding_in_their_own_shadow_is_found_in_their_revealed_readings():
