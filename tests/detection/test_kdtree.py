@@ -1,4 +1,4 @@
-"""The nearest-neighbour search gives the same answers from either library."""
+"""The nearest-neighbour search gives the same answers from the compiled grid and either library."""
 
 import os
 import subprocess
@@ -14,7 +14,9 @@ from people_tracker.tracker.config import load_config
 from people_tracker.tracker.io.recording import Recording
 from people_tracker.tracker.people_tracker import PeopleTracker
 
-needs_both = pytest.mark.skipif(len(kdtree.BACKENDS) < 2, reason="pykdtree is not installed: only scipy's tree to compare")
+needs_both = pytest.mark.skipif(len(kdtree.BACKENDS) < 2,
+                                reason="neither pykdtree nor numba is installed: only scipy's tree to compare")
+needs_grid = pytest.mark.skipif("grid" not in kdtree.BACKENDS, reason="numba is not installed (the [fast] extra): no grid")
 
 
 def test_an_empty_tree_finds_nothing():
@@ -40,38 +42,59 @@ def _scans(bag, n):
         return cfg, [(r.scan, r.pose, r.pose_last_beam) for r in islice(rec.scans(), n) if r.scan is not None]
 
 
+def _agree(ref, query, bounds=(0.02, 0.05, 0.3, 1.0, np.inf)):
+    """Every installed backend gives scipy's distances and indices, bit for bit."""
+    for bound in bounds:
+        slow = PointTree(ref, "scipy").query(query, bound)
+        for backend in kdtree.BACKENDS:
+            fast = PointTree(ref, backend).query(query, bound)
+            np.testing.assert_array_equal(fast[0], slow[0], err_msg=f"{backend}, bound {bound}")
+            np.testing.assert_array_equal(fast[1], slow[1], err_msg=f"{backend}, bound {bound}")
+
+
 @needs_both
-def test_both_libraries_agree_on_real_scans(moving_bag):
+def test_every_backend_agrees_on_real_scans(moving_bag):
     _, scans = _scans(moving_bag, 60)
+    rng = np.random.default_rng(3)
     for (a, _, _), (b, _, _) in zip(scans, scans[5:]):
-        ref, query = a.valid_points, b.valid_points + 0.01
-        for bound in (0.05, 0.3, np.inf):
-            fast = PointTree(ref, "pykdtree").query(query, bound)
-            slow = PointTree(ref, "scipy").query(query, bound)
-            np.testing.assert_array_equal(fast[0], slow[0])
-            np.testing.assert_array_equal(fast[1], slow[1])
+        _agree(a.valid_points, b.valid_points + 0.01)
+        _agree(a.valid_points, b.valid_points + rng.normal(0.0, 0.1, b.valid_points.shape))
+
+
+@needs_grid
+def test_the_grid_agrees_where_its_cells_are_odd():
+    rng = np.random.default_rng(4)
+    far = rng.uniform(-500.0, 500.0, size=(300, 2))  # a wide extent: cells grow past 0.1 m
+    line = np.column_stack([np.linspace(0.0, 30.0, 400), np.full(400, 2.0)])  # one row of cells
+    one = np.array([[1.0, -1.0]])
+    same = np.repeat(one, 5, axis=0)  # every point in one place: ties go to the lowest index
+    queries = np.vstack([rng.uniform(-50.0, 50.0, size=(200, 2)), [[1e6, -1e6], [1.0, -1.0]]])  # in, far out
+    for ref in (far, line, one, same):
+        _agree(ref, queries)
+    d, i = PointTree(same, "grid").query(np.array([[1.0, -1.0], [np.nan, 0.0], [0.0, np.inf]]), 1.0)
+    assert d.tolist() == [0.0, np.inf, np.inf] and i.tolist() == [0, 5, 5]  # nothing is near no place
 
 
 @needs_both
-def test_the_tracker_reports_the_same_people_with_either_library(moving_bag, monkeypatch):
+def test_the_tracker_reports_the_same_people_with_every_backend(moving_bag, monkeypatch):
     cfg, scans = _scans(moving_bag, 300)
-    runs = []
-    for backends in (("pykdtree", "scipy"), ("scipy",)):
-        monkeypatch.setattr(kdtree, "BACKENDS", backends)
+    runs, every = [], kdtree.BACKENDS
+    for k in range(len(every)):  # the default first, then without it, and so on
+        monkeypatch.setattr(kdtree, "BACKENDS", every[k:])
         tracker = PeopleTracker.from_config(cfg)
         runs.append([[(t.track_id, t.x, t.y, t.status) for t in tracker.step(*s)] for s in scans])
     assert sum(map(len, runs[0])) > 50  # people were reported: the comparison means something
-    assert runs[0] == runs[1]
+    assert all(run == runs[0] for run in runs[1:])
 
 
 _THREADS = """
 import os, numpy as np
 from people_tracker.detection.kdtree import BACKENDS, PointTree
-tree = PointTree(np.random.default_rng(0).uniform(size=(500, 2)))
+tree = PointTree(np.random.default_rng(0).uniform(size=(500, 2)), "pykdtree")
 before = len(os.listdir("/proc/self/task"))
 for _ in range(200):
     tree.query(np.random.default_rng(1).uniform(size=(300, 2)), 0.1)
-print(BACKENDS[0], before, len(os.listdir("/proc/self/task")), os.environ.get("OMP_NUM_THREADS"))
+print("pykdtree" in BACKENDS, before, len(os.listdir("/proc/self/task")), os.environ.get("OMP_NUM_THREADS"))
 """
 
 
@@ -87,4 +110,4 @@ def test_queries_start_no_threads_and_leave_the_environment_alone(omp, tmp_path)
     out = subprocess.run([sys.executable, "-c", _THREADS], env=env, capture_output=True, text=True, check=True,
                          cwd=tmp_path)
     backend, before, after, left = out.stdout.split()
-    assert backend == "pykdtree" and after == before and left == str(omp)
+    assert backend == "True" and after == before and left == str(omp)
