@@ -11,9 +11,12 @@ evidence that the person is still there is :mod:`people_tracker.tracker.existenc
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from people_tracker.detection.segments import run_bounds
+from people_tracker.models import compiled
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
@@ -61,9 +64,16 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
     bounds = run_bounds(pts, gap)  # the scan's segments, any label
     seg_of = np.repeat(np.arange(len(bounds) - 1), np.diff(bounds))
     pred_sensor = pose.inverse().transform_points(predictions_world)
-    d = pairwise_distances(pred_sensor, pts)
     free = np.ones(len(valid), dtype=bool) if explained is None else ~explained[valid]
     needed_valid = None if needed is None else needed[valid]  # per valid reading, as ``free``
+    if compiled.on:  # the loop below, compiled: each prediction's group, checked and centred
+        found, centres = _support_kernel(
+            pred_sensor, pts, seg_of, len(bounds) - 1, free, needed_valid is not None,
+            needed_valid if needed_valid is not None else free, radius_m, max_size_m, min_points, max_leg_radius_m)
+        for t in np.flatnonzero(found):
+            out[t] = pose.transform_points(centres[t:t + 1])[0]
+        return out
+    d = pairwise_distances(pred_sensor, pts)
     d[:, ~free] = np.inf
     chosen = np.zeros(len(bounds) - 1, dtype=bool)
     for t in range(len(pred_sensor)):
@@ -84,3 +94,57 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
             centre = leg_centres(centre, np.array([extent]), max_leg_radius_m)
         out[t] = pose.transform_points(centre)[0]
     return out
+
+
+def _support_loop(pred_sensor, pts, seg_of, n_segments, free, use_needed, needed, radius_m, max_size_m, min_points,
+                  max_leg_radius_m):
+    """:func:`static_support`'s loop over the predictions (sensor frame) as its numpy code
+    runs it, the same arithmetic in the same order: whether each is supported, and where
+    (sensor frame, metres; the leg centres' step back included)."""
+    t_count, n = len(pred_sensor), len(pts)
+    found = np.zeros(t_count, np.bool_)
+    centres = np.zeros((t_count, 2))
+    chosen = np.zeros(n_segments, np.bool_)
+    for t in range(t_count):
+        qx, qy = pred_sensor[t, 0], pred_sensor[t, 1]
+        chosen[:] = False
+        any_near = False
+        for i in range(n):
+            if free[i] and np.hypot(qx - pts[i, 0], qy - pts[i, 1]) <= radius_m:
+                chosen[seg_of[i]] = True
+                any_near = True
+        if not any_near:
+            continue
+        count, count_needed = 0, 0
+        sx, sy = 0.0, 0.0
+        x_lo, x_hi, y_lo, y_hi = np.inf, -np.inf, np.inf, -np.inf
+        for i in range(n):
+            if chosen[seg_of[i]] and free[i]:
+                x, y = pts[i, 0], pts[i, 1]
+                if count == 0:
+                    sx, sy = x, y  # numpy's mean over the rows: the first row, then each in turn
+                else:
+                    sx += x
+                    sy += y
+                count += 1
+                if use_needed and needed[i]:
+                    count_needed += 1
+                x_lo, x_hi = min(x_lo, x), max(x_hi, x)
+                y_lo, y_hi = min(y_lo, y), max(y_hi, y)
+        extent = np.hypot(x_hi - x_lo, y_hi - y_lo)
+        if count < min_points or extent > max_size_m:
+            continue
+        if use_needed and count_needed < min_points:
+            continue
+        mx, my = sx / count, sy / count
+        if max_leg_radius_m > 0:  # leg_centres: a step back along the beam
+            r = min(max(0.5 * extent, 0.0), max_leg_radius_m)
+            norm = max(np.hypot(mx, my), 1e-9)
+            step = 0.25 * math.pi * r
+            mx, my = mx + (mx / norm) * step, my + (my / norm) * step
+        found[t] = True
+        centres[t, 0], centres[t, 1] = mx, my
+    return found, centres
+
+
+_support_kernel = compiled.njit(_support_loop)

@@ -121,6 +121,29 @@ def test_place_visibility_agrees_on_simulated_lasers(laser):
     assert codes == {0, 1, 2, 3}  # every outcome was compared
 
 
+@pytest.mark.parametrize("laser", sorted(LASERS))
+def test_static_support_agrees_on_simulated_lasers(laser):
+    from people_tracker.tracker.static_support import static_support
+    rng = np.random.default_rng(12)
+    supported = 0
+    for scan in _simulated(LASERS[laser], seconds=2.0):
+        pose = Pose2D(*rng.uniform(-1, 1, 2), rng.uniform(-3, 3))
+        pts = scan.valid_points
+        near = pts[rng.integers(0, len(pts), 30)] + rng.normal(0.0, 0.2, (30, 2))  # beside readings, and not
+        predictions = pose.transform_points(np.vstack([near, rng.uniform(-8, 8, (10, 2))]))
+        masks = rng.random((2, scan.n_beams)) < np.array([[0.2], [0.7]])
+        for explained, needed, leg_radius in ((None, None, 0.0), (masks[0], None, 0.1), (None, masks[1], 0.06),
+                                              (masks[0], masks[1], 0.1)):
+            args = (predictions, pose, scan, 2.5, 0.1, 0.3, 0.8, 3, leg_radius, explained, needed)
+            fast = static_support(*args)
+            with compiled.numpy_only():
+                ref = static_support(*args)
+            assert [None if f is None else f.tobytes() for f in fast] == \
+                [None if r is None else r.tobytes() for r in ref]
+            supported += sum(f is not None for f in fast)
+    assert supported > 100  # places were supported: the comparison means something
+
+
 def test_bearing_to_beam_agrees_with_beam_index():
     rng = np.random.default_rng(3)
     for n, inc in ((768, np.radians(0.35)), (811, -np.radians(1 / 3)), (1440, np.radians(0.25)),
