@@ -154,9 +154,22 @@ class Existence:
         self.stamp = stamp
 
     @property
-    def l_shape(self) -> float:
+    def shape_p(self) -> float:
+        """The leg model's probability at the track's place, smoothed over ``shape_time_s``."""
+        return self._shape_p
+
+    @shape_p.setter
+    def shape_p(self, value: float) -> None:
+        # the shape's log-likelihood ratio is read several times a scan per track: worked
+        # out once each time the probability changes
+        self._shape_p = value
         p = self.params
-        return min(max(logit(self.shape_p) - self.base, math.log(p.min_shape_lr)), math.log(p.max_shape_lr))
+        self._l_shape = min(max(logit(value) - self.base, math.log(p.min_shape_lr)), math.log(p.max_shape_lr))
+
+    @property
+    def l_shape(self) -> float:
+        """The leg shape's evidence, log-odds, clipped to ``[ln min_shape_lr, ln max_shape_lr]``."""
+        return self._l_shape
 
     @property
     def probability(self) -> float:
