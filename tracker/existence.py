@@ -154,22 +154,9 @@ class Existence:
         self.stamp = stamp
 
     @property
-    def shape_p(self) -> float:
-        """The leg model's probability at the track's place, smoothed over ``shape_time_s``."""
-        return self._shape_p
-
-    @shape_p.setter
-    def shape_p(self, value: float) -> None:
-        # the shape's log-likelihood ratio is read several times a scan per track: worked
-        # out once each time the probability changes
-        self._shape_p = value
-        p = self.params
-        self._l_shape = min(max(logit(value) - self.base, math.log(p.min_shape_lr)), math.log(p.max_shape_lr))
-
-    @property
     def l_shape(self) -> float:
-        """The leg shape's evidence, log-odds, clipped to ``[ln min_shape_lr, ln max_shape_lr]``."""
-        return self._l_shape
+        p = self.params
+        return min(max(logit(self.shape_p) - self.base, math.log(p.min_shape_lr)), math.log(p.max_shape_lr))
 
     @property
     def probability(self) -> float:
