@@ -877,6 +877,10 @@ def warm_up_kernels(config=None) -> float:
         last = tracker.last  # where no track coasted: the place test on its own
         place_visibility(np.array([[1.0, 0.5], [3.0, -1.0]]), last.scan, last.pose, config.existence.place_radius_m,
                          tracker.detector.params.no_return_free_m)
+        # and static support, which a short scene may never ask for (no confirmed track idle)
+        near = last.pose.transform_points(last.scan.valid_points[:1])
+        tracker._static_support(near, last.scan, last.pose, np.zeros(last.scan.n_beams, dtype=bool),
+                                np.ones(last.scan.n_beams, dtype=bool))
     return time.perf_counter() - t0
 
 
