@@ -115,7 +115,7 @@ def test_ctrl_c_ends_a_run_with_130_and_no_files(tmp_path, extra):
         time.sleep(0.01)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=20)
-    assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err
+    assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err, err
     assert os.listdir(tmp_path) == []
 
 
