@@ -501,6 +501,19 @@ def _cmd_replay(args) -> int:
     return replay(args.input, args.topic, args.rate, load_config(), args.wait, args.ros_args)
 
 
+def _interrupted(exc: BaseException) -> bool:
+    """Whether ``exc`` stands for Ctrl-C: a KeyboardInterrupt that reached Python inside a
+    compiled call comes back wrapped (numba's dispatcher: "SystemError: ... returned a
+    result with an exception set", the interrupt as its cause)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``people-tracker`` console script; returns the exit status."""
     argv = sys.argv[1:] if argv is None else argv
@@ -533,6 +546,10 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:
         return 0
     except Exception as exc:  # never a traceback for users; PEOPLE_TRACKER_DEBUG=1 shows it
+        if _interrupted(exc):
+            handler.summary()
+            print(f"{PROG}: interrupted", file=sys.stderr)
+            return 130
         if os.environ.get("PEOPLE_TRACKER_DEBUG"):
             raise
         handler.summary()
