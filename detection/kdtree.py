@@ -13,10 +13,9 @@ checks that all give the same answers on real scans.
 
 from __future__ import annotations
 
+import math
 import os
 import sys
-
-import math
 
 import numpy as np
 
@@ -119,9 +118,12 @@ def _grid_query(points, geometry, shape, start, order, q, bound):
             i_lo, i_hi = max(cx - k, 0), min(cx + k, nx - 1)
             j_lo, j_hi = max(cy - k, 0), min(cy + k, ny - 1)
             for i in range(i_lo, i_hi + 1):
-                side = i == cx - k or i == cx + k  # the ring's whole column, else only its two ends
-                for j in range(j_lo, j_hi + 1):
-                    if not side and j != cy - k and j != cy + k:
+                if i == cx - k or i == cx + k:  # the ring's whole column ...
+                    j_first, j_step = j_lo, 1
+                else:  # ... else only its two ends, each where it lies inside the grid
+                    j_first, j_step = cy - k, 2 * k
+                for j in range(j_first, j_hi + 1, j_step):
+                    if j < j_lo:
                         continue
                     c = i * ny + j
                     for s in range(start[c], start[c + 1]):
@@ -162,8 +164,8 @@ class PointTree:
             raise ValueError(f"KD-tree backend {backend!r} is not installed (have: {', '.join(BACKENDS)})")
         self._tree = self._grid = None
         if self.n == 0:
-            pass
-        elif backend == "grid":
+            return
+        if backend == "grid":
             self._points = points
             self._grid = _grid_build(points, GRID_CELL_M, GRID_MAX_CELLS)
         elif backend == "pykdtree":

@@ -16,8 +16,8 @@ import math
 import numpy as np
 
 from people_tracker.detection.segments import run_bounds
-from people_tracker.models import compiled
 from people_tracker.detection.thresholds import range_threshold
+from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
 from people_tracker.tracker.pairing import leg_centres
