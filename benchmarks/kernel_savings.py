@@ -13,6 +13,7 @@ the fastest pass of each is kept. Variants:
 - ``compiled``: everything compiled (the default when numba is installed);
 - ``without the grid search``: the nearest neighbours from pykdtree instead;
 - ``without the static support kernel``: static support in numpy;
+- ``without the hull kernel``: the objects' hull centroids and boxes from shapely;
 - ``numpy only``: every kernel off (``PEOPLE_TRACKER_COMPILED=0``).
 
 Inputs: the annotated recording (``general_tracking_moving_1.bag``, its first ``--scans``
@@ -32,7 +33,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_pipeline import DATA, _one_core  # noqa: E402
 
-from people_tracker.detection import kdtree  # noqa: E402
+from people_tracker.detection import kdtree, objects  # noqa: E402
 from people_tracker.models import compiled  # noqa: E402
 from people_tracker.models.scenario import build_simulation, load_scenario  # noqa: E402
 from people_tracker.tracker import static_support  # noqa: E402
@@ -43,17 +44,22 @@ from people_tracker.tracker.people_tracker import PeopleTracker, warm_up_kernels
 _ALL_BACKENDS = kdtree.BACKENDS
 
 
-def _set(grid: bool, support: bool, kernels: bool) -> None:
+_OFF = types.SimpleNamespace(on=False)
+
+
+def _set(grid: bool, support: bool, hull: bool, kernels: bool) -> None:
     kdtree.BACKENDS = _ALL_BACKENDS if grid else kdtree.LIBRARIES
-    static_support.compiled = compiled if support else types.SimpleNamespace(on=False)
+    static_support.compiled = compiled if support else _OFF
+    objects.compiled = compiled if hull else _OFF
     compiled.on = kernels
 
 
 VARIANTS = {
-    "compiled": (True, True, True),
-    "without the grid search": (False, True, True),
-    "without the static support kernel": (True, False, True),
-    "numpy only": (False, False, False),
+    "compiled": (True, True, True, True),
+    "without the grid search": (False, True, True, True),
+    "without the static support kernel": (True, False, True, True),
+    "without the hull kernel": (True, True, False, True),
+    "numpy only": (False, False, False, False),
 }
 
 
@@ -72,7 +78,7 @@ def compare(name: str, config, items, passes: int) -> bool:
             _set(*switches)
             seconds, outputs[variant] = _pass(config, items)
             best[variant] = min(best[variant], seconds)
-    _set(True, True, True)
+    _set(True, True, True, True)
     base = best["compiled"]
     print(f"{name}: {len(items)} scans, the fastest of {passes} passes")
     for variant in VARIANTS:
