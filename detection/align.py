@@ -19,7 +19,7 @@ import numpy as np
 from people_tracker.detection.deskew import deskew, sweep_duration
 from people_tracker.detection.icp import IcpParams, MatchResult, ReferenceScan, match
 from people_tracker.detection.kdtree import PointTree
-from people_tracker.models.pose import Pose2D, interpolate_pose, pairwise_distances
+from people_tracker.models.pose import Pose2D, interpolate_pose, near_any
 from people_tracker.models.scan import Scan
 
 
@@ -105,8 +105,7 @@ class ScanAligner:
         if people_world is None or not len(people_world) or not len(points):
             return None
         local = (self._world @ rel).inverse().transform_points(np.asarray(people_world, dtype=float))
-        d = pairwise_distances(points, local)
-        return d.min(axis=1) < self.params.exclude_radius_m
+        return near_any(points, local, self.params.exclude_radius_m)
 
     def align(self, scan: Scan, odom: Pose2D | None = None, odom_last_beam: Pose2D | None = None,
               people_world: np.ndarray | None = None) -> Alignment:

@@ -8,6 +8,8 @@ from functools import cached_property
 
 import numpy as np
 
+from people_tracker.models import compiled
+
 
 def wrap_angle(angle):
     """Wrap an angle (or array of angles) in radians to [-pi, pi)."""
@@ -100,3 +102,33 @@ def pairwise_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Euclidean distance of every point of ``a`` (shape (n, 2)) to every point of ``b``
     (shape (m, 2)), both in one frame, metres; shape (n, m)."""
     return np.hypot(a[:, None, 0] - b[None, :, 0], a[:, None, 1] - b[None, :, 1])
+
+
+def near_any(a: np.ndarray, b: np.ndarray, radius_m: float) -> np.ndarray:
+    """Whether each point of ``a`` (shape (n, 2)) lies closer than ``radius_m`` metres to some
+    point of ``b`` (shape (m, 2)), both in one frame: ``pairwise_distances(a, b).min(axis=1) <
+    radius_m``, and the same answer (a compiled loop that skips the distance of a pair
+    farther apart than the radius along x or y, when numba is on and every point is finite)."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    if not len(a) or not len(b):
+        return np.zeros(len(a), dtype=bool)
+    if compiled.on and np.isfinite(a).all() and np.isfinite(b).all():
+        return _near_any_kernel(np.ascontiguousarray(a), np.ascontiguousarray(b), float(radius_m))
+    return pairwise_distances(a, b).min(axis=1) < radius_m
+
+
+def _near_any_loop(a, b, radius_m):
+    """:func:`near_any` for finite points: a distance is at least its larger side, so a pair
+    that far apart along x or y is not near, and the others are measured as numpy does
+    (``hypot``)."""
+    out = np.zeros(len(a), np.bool_)
+    for i in range(len(a)):
+        for j in range(len(b)):
+            dx, dy = a[i, 0] - b[j, 0], a[i, 1] - b[j, 1]
+            if abs(dx) < radius_m and abs(dy) < radius_m and np.hypot(dx, dy) < radius_m:
+                out[i] = True
+                break
+    return out
+
+
+_near_any_kernel = compiled.njit(_near_any_loop)

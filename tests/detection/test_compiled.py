@@ -189,6 +189,27 @@ def test_hull_centroids_and_boxes_agree_with_shapely():
     assert (sides[1][:, 0] > 0).sum() > 1000 and (sides[1][:, 0] == 0).sum() > 500  # boxes, lines and points
 
 
+def test_near_any_agrees_with_the_distance_matrix():
+    from people_tracker.models.pose import near_any
+    rng = np.random.default_rng(8)
+    near = 0
+    for k in range(3000):
+        a, b = rng.uniform(-5, 5, (int(rng.integers(0, 50)), 2)), rng.uniform(-5, 5, (int(rng.integers(0, 8)), 2))
+        m = min(len(a), len(b))
+        a[:m] = b[:m] + rng.normal(0, 0.3, (m, 2))
+        radius = 0.5 if k % 4 == 0 else float(rng.uniform(0, 1))
+        if k % 4 == 0 and m:
+            a[0] = b[0] + [0.3, 0.4]  # on the radius: not near (strictly closer only)
+        if k % 7 == 0 and m:
+            a[-1, 0] = np.nan  # a lost reading: the numpy path answers
+        fast = near_any(a, b, radius)
+        with compiled.numpy_only():
+            ref = near_any(a, b, radius)
+        assert fast.tobytes() == ref.tobytes(), k
+        near += int(fast.sum())
+    assert near > 1000
+
+
 def test_bearing_to_beam_agrees_with_beam_index():
     rng = np.random.default_rng(3)
     for n, inc in ((768, np.radians(0.35)), (811, -np.radians(1 / 3)), (1440, np.radians(0.25)),
