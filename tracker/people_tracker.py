@@ -434,28 +434,22 @@ class PeopleTracker:
         s_own = owners(s_xy, np.array([t.position for t in everyone]).reshape(-1, 2), self.pairing.half_stride_m)
         index = {o.object_id: i for i, o in enumerate(detection.objects)}
         out = list(candidates)
-        taken: set[int] = set()
         # lone legs take partners counter-clockwise (by bearing, not by beam order), so that
         # a clockwise laser pairs the same legs as a counter-clockwise one
         seen = world.inverse().transform_points(xy)  # the legs in the sensor frame
         lone.sort(key=lambda k: math.atan2(*seen[index[candidates[k].object_ids[0]]][::-1]))
-        for k in lone:
-            i = index[candidates[k].object_ids[0]]
-            if groups[i] < 0:
-                continue
-            walker = walking[groups[i]]
-            d = np.hypot(*(s_xy - xy[i]).T)
-            ok = ((d >= 2.0 * self.pairing.max_leg_radius_m) & (d <= self.pairing.max_leg_separation_m)
-                  & np.array([o < 0 or everyone[o] is walker for o in s_own], dtype=bool))
-            mids = 0.5 * (s_xy + xy[i])
-            ok &= np.hypot(*(mids - walker.position).T) < np.hypot(*(xy[i] - walker.position))
-            ok[list(taken)] = False
-            if not ok.any():
-                continue
-            j = int(np.flatnonzero(ok)[np.argmin(d[ok])])
-            taken.add(j)
-            out[k] = PersonCandidate(float(mids[j, 0]), float(mids[j, 1]), self.pairing.sigma_pair_m, "pair",
-                                     candidates[k].object_ids)
+        at = {id(t): n for n, t in enumerate(everyone)}
+        leg = np.array([index[candidates[k].object_ids[0]] for k in lone], dtype=np.int64)
+        walker = [walking[groups[i]] if groups[i] >= 0 else None for i in leg]
+        partner, mids = (_stance_kernel if compiled.on else _stance_partner_choice)(
+            np.ascontiguousarray(s_xy), np.asarray(s_own, dtype=np.int64), np.ascontiguousarray(xy), leg,
+            np.array([-2 if w is None else at.get(id(w), -1) for w in walker], dtype=np.int64),
+            np.array([(np.nan, np.nan) if w is None else w.position for w in walker], dtype=float).reshape(-1, 2),
+            2.0 * self.pairing.max_leg_radius_m, float(self.pairing.max_leg_separation_m))
+        for n, k in enumerate(lone):
+            if partner[n] >= 0:
+                out[k] = PersonCandidate(float(mids[n, 0]), float(mids[n, 1]), self.pairing.sigma_pair_m, "pair",
+                                         candidates[k].object_ids)
         return out
 
     def _receding(self, detection: Detection, scan: Scan, world: Pose2D) -> list[PersonCandidate]:
@@ -852,6 +846,68 @@ def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:
     if not tracks:
         return np.zeros((0, 2))
     return pose.inverse().transform_points(np.array([(t.x, t.y) for t in tracks]))
+
+
+
+def _stance_partner_choice(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d):
+    """Which still leg each lone moving leg of :meth:`PeopleTracker._stance_partners` pairs
+    with, in the order given: for lone leg ``n`` (reading set ``leg[n]`` at ``xy[leg[n]]``,
+    world frame, m; its walker at ``walker_xy[n]``, index ``walker_at[n]`` among the
+    confirmed tracks, -1 when not among them, -2 when no walking track owns the leg), the
+    nearest still leg ``s_xy[j]`` not taken by an earlier one, ``min_d``..``max_d`` metres
+    away, owned by nobody (``s_own[j]`` -1) or that walker, whose midpoint with the leg lies
+    nearer the walker than the leg does; -1 for none. Returns the partners and the pairs'
+    midpoints (the numpy reference of :func:`_stance_loop`)."""
+    partner = np.full(len(leg), -1, np.int64)
+    mids_out = np.zeros((len(leg), 2))
+    taken: set[int] = set()
+    for n, i in enumerate(leg):
+        if walker_at[n] == -2:
+            continue
+        d = np.hypot(*(s_xy - xy[i]).T)
+        ok = (d >= min_d) & (d <= max_d) & ((s_own < 0) | (s_own == walker_at[n]))
+        mids = 0.5 * (s_xy + xy[i])
+        ok &= np.hypot(*(mids - walker_xy[n]).T) < np.hypot(*(xy[i] - walker_xy[n]))
+        ok[list(taken)] = False
+        if not ok.any():
+            continue
+        j = int(np.flatnonzero(ok)[np.argmin(d[ok])])
+        taken.add(j)
+        partner[n], mids_out[n] = j, mids[j]
+    return partner, mids_out
+
+
+def _stance_loop(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d):
+    """:func:`_stance_partner_choice` in one compiled loop (numba), the same choices."""
+    n_lone, n_still = len(leg), len(s_xy)
+    partner = np.full(n_lone, -1, np.int64)
+    mids = np.zeros((n_lone, 2))
+    taken = np.zeros(n_still, np.bool_)
+    for n in range(n_lone):
+        if walker_at[n] == -2:
+            continue
+        x, y = xy[leg[n], 0], xy[leg[n], 1]
+        wx, wy = walker_xy[n, 0], walker_xy[n, 1]
+        reach = np.hypot(x - wx, y - wy)
+        best, best_d = -1, np.inf
+        for j in range(n_still):
+            if taken[j] or not (s_own[j] < 0 or s_own[j] == walker_at[n]):
+                continue
+            d = np.hypot(s_xy[j, 0] - x, s_xy[j, 1] - y)
+            if not (d >= min_d and d <= max_d):
+                continue
+            if not np.hypot(0.5 * (s_xy[j, 0] + x) - wx, 0.5 * (s_xy[j, 1] + y) - wy) < reach:
+                continue
+            if d < best_d:  # the first of equal distances, as argmin
+                best, best_d = j, d
+        if best >= 0:
+            partner[n] = best
+            taken[best] = True
+            mids[n, 0], mids[n, 1] = 0.5 * (s_xy[best, 0] + x), 0.5 * (s_xy[best, 1] + y)
+    return partner, mids
+
+
+_stance_kernel = compiled.njit(_stance_loop)
 
 
 def warm_up_kernels(config=None) -> float:

@@ -210,6 +210,27 @@ def test_near_any_agrees_with_the_distance_matrix():
     assert near > 1000
 
 
+def test_stance_partners_agree():
+    """Lone moving legs choosing standing partners: the compiled loop and the numpy code
+    make the same choices, with several legs wanting the same partner and ties in distance."""
+    from people_tracker.tracker.people_tracker import _stance_kernel, _stance_partner_choice
+    rng = np.random.default_rng(9)
+    paired = 0
+    for k in range(2000):
+        n_still, n_legs, n_tracks = int(rng.integers(1, 12)), int(rng.integers(1, 10)), int(rng.integers(1, 5))
+        s_xy = rng.uniform(0, 2, (n_still, 2)).round(2 if k % 3 == 0 else 8)  # rounded: equal distances
+        xy = rng.uniform(0, 2, (n_legs + 3, 2)).round(2 if k % 3 == 0 else 8)
+        s_own = rng.integers(-1, n_tracks, n_still)
+        leg = rng.permutation(len(xy))[:n_legs].astype(np.int64)
+        walker_at = rng.integers(-2, n_tracks, n_legs)
+        walker_xy = xy[leg] + rng.normal(0, 0.3, (n_legs, 2))
+        args = (s_xy, s_own, xy, leg, walker_at, walker_xy, 0.1, 0.9)
+        fast, ref = _stance_kernel(*args), _stance_partner_choice(*args)
+        assert fast[0].tobytes() == ref[0].tobytes() and fast[1].tobytes() == ref[1].tobytes(), k
+        paired += int((fast[0] >= 0).sum())
+    assert paired > 1000
+
+
 def test_bearing_to_beam_agrees_with_beam_index():
     rng = np.random.default_rng(3)
     for n, inc in ((768, np.radians(0.35)), (811, -np.radians(1 / 3)), (1440, np.radians(0.25)),
