@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/kernel_savings.py [--passes 5] [--scans 500] [--crowd-scans 150]
+    python benchmarks/kernel_savings.py [--passes 15] [--scans 300] [--crowd-scans 100]
 
 This machine's speed drifts by tens of percent between runs minutes apart, so timings from
 separate runs cannot show a saving of a few percent. Here every variant runs in this one
@@ -89,9 +89,9 @@ def compare(name: str, config, items, passes: int) -> bool:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--passes", type=int, default=5, help="passes of each variant (default 5)")
-    ap.add_argument("--scans", type=int, default=500, help="scans of the recording (default 500)")
-    ap.add_argument("--crowd-scans", type=int, default=150, help="scans of the crowd of 50 (default 150)")
+    ap.add_argument("--passes", type=int, default=15, help="passes of each variant (default 15)")
+    ap.add_argument("--scans", type=int, default=300, help="scans of the recording (default 300)")
+    ap.add_argument("--crowd-scans", type=int, default=100, help="scans of the crowd of 50 (default 100)")
     args = ap.parse_args(argv)
     if not compiled.ENABLED:
         print("the compiled kernels are off (numba is not installed, or PEOPLE_TRACKER_COMPILED=0): nothing to compare")

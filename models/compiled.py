@@ -14,7 +14,9 @@ compilation.
 The arithmetic follows the numpy code's order (the same expressions; a segment's sum in
 the order ``np.add.reduceat`` adds, :func:`reduceat_sum`), and numba does not fuse or
 reorder floating-point operations unless asked to (``fastmath`` is off), so the results
-agree to the last bit on every scan the test has seen. This module sits in ``models``,
+agree to the last bit on every scan the test has seen. One exception: an object's box
+sides (:func:`people_tracker.detection.objects.describe_all`), which shapely takes from
+corners GEOS intersects in double-double precision, agree to 1e-12 m. This module sits in ``models``,
 beside :func:`people_tracker.models.scan.beam_index` whose one-bearing twin it holds, so
 that every layer can use it (the leg model too).
 """
