@@ -245,13 +245,8 @@ class PeopleTracker:
     def _best_leg(self, xy_world: np.ndarray, radius_m: float | None = None) -> np.ndarray:
         """The best leg probability among this scan's leg candidates within ``radius_m``
         (default: the support radius) of each place (world frame); nan where there is none."""
-        out = np.full(len(xy_world), np.nan)
-        if len(xy_world) and len(self._legs_world):
-            d = pairwise_distances(xy_world, self._legs_world)
-            near = d <= (self.assoc.support_radius_m if radius_m is None else radius_m)
-            scores = np.where(near, self._leg_scores[None, :], -1.0).max(axis=1)
-            out = np.where(near.any(axis=1), scores, np.nan)
-        return out
+        return best_within(xy_world, self._legs_world, self._leg_scores,
+                           self.assoc.support_radius_m if radius_m is None else radius_m)
 
     def _weigh(self, scan: Scan, world: Pose2D) -> None:
         """Each track's existence evidence from this scan: its update, whether the scan saw
@@ -847,6 +842,43 @@ def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:
         return np.zeros((0, 2))
     return pose.inverse().transform_points(np.array([(t.x, t.y) for t in tracks]))
 
+
+
+def best_within(places: np.ndarray, legs: np.ndarray, scores: np.ndarray, radius_m: float) -> np.ndarray:
+    """The best of ``scores`` (one per row of ``legs``) among the legs within ``radius_m``
+    metres of each of ``places`` (both (n, 2), one frame); nan where there is none. A compiled
+    loop when numba is on and the scores are finite (a pair farther apart along x or y than
+    the radius is not within it; the others are measured with ``hypot``, as numpy does), the
+    same answers as the numpy expression, which stays the reference."""
+    out = np.full(len(places), np.nan)
+    if not len(places) or not len(legs):
+        return out
+    if compiled.on and np.isfinite(scores).all():
+        return _best_within_kernel(np.ascontiguousarray(places, dtype=np.float64),
+                                   np.ascontiguousarray(legs, dtype=np.float64),
+                                   np.ascontiguousarray(scores, dtype=np.float64), float(radius_m))
+    near = pairwise_distances(places, legs) <= radius_m
+    best = np.where(near, scores[None, :], -1.0).max(axis=1)
+    return np.where(near.any(axis=1), best, np.nan)
+
+
+def _best_within_loop(places, legs, scores, radius_m):
+    """:func:`best_within` as one compiled loop (finite scores)."""
+    out = np.full(len(places), np.nan)
+    for i in range(len(places)):
+        best, found = -1.0, False
+        for j in range(len(legs)):
+            dx, dy = places[i, 0] - legs[j, 0], places[i, 1] - legs[j, 1]
+            if abs(dx) <= radius_m and abs(dy) <= radius_m and np.hypot(dx, dy) <= radius_m:
+                found = True
+                if scores[j] > best:
+                    best = scores[j]
+        if found:
+            out[i] = best
+    return out
+
+
+_best_within_kernel = compiled.njit(_best_within_loop)
 
 
 def _stance_partner_choice(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d):

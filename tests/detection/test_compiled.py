@@ -210,6 +210,29 @@ def test_near_any_agrees_with_the_distance_matrix():
     assert near > 1000
 
 
+def test_best_leg_within_a_radius_agrees():
+    from people_tracker.tracker.people_tracker import best_within
+    rng = np.random.default_rng(10)
+    found = 0
+    for k in range(3000):
+        places = rng.uniform(0, 3, (int(rng.integers(0, 20)), 2))
+        legs = rng.uniform(0, 3, (int(rng.integers(0, 30)), 2))
+        scores = rng.random(len(legs)).round(2)  # ties among the best
+        radius = 0.5 if k % 3 == 0 else float(rng.uniform(0, 1))
+        if k % 3 == 0 and len(places) and len(legs):
+            places[0] = legs[0] + [0.3, 0.4]  # on the radius: within it
+        if k % 11 == 0 and len(places):
+            places[-1, 1] = np.nan  # nowhere: nothing within reach
+        if k % 13 == 0 and len(scores):
+            scores[0] = np.nan  # the numpy path answers
+        fast = best_within(places, legs, scores, radius)
+        with compiled.numpy_only():
+            ref = best_within(places, legs, scores, radius)
+        assert fast.tobytes() == ref.tobytes(), k
+        found += int(np.isfinite(fast).sum())
+    assert found > 5000
+
+
 def test_stance_partners_agree():
     """Lone moving legs choosing standing partners: the compiled loop and the numpy code
     make the same choices, with several legs wanting the same partner and ties in distance."""
