@@ -104,7 +104,6 @@ def describe_all(first_id: int, beams: list[np.ndarray], points: list[np.ndarray
                          float(length[k]), recovered_name(sets[k])) for k in range(len(points))]
 
 
-
 def _orient(ax, ay, bx, by, cx, cy):
     """Which way ``a``, ``b``, ``c`` turn, by GEOS's floating-point filter (the test its
     robust orientation makes first): 1 counter-clockwise, -1 clockwise, 0 on a line, 2 when
@@ -263,7 +262,7 @@ def _describe_loop(pts, offsets):
             ax, ay, bx, by = p[ccw[0], 0], p[ccw[0], 1], p[ccw[1], 0], p[ccw[1], 1]
             seg = _distance(ax, ay, bx, by)
             cx[k], cy[k] = seg * ((ax + bx) / 2.0) / seg, seg * ((ay + by) / 2.0) / seg
-            length[k] = 0.0 + seg
+            length[k] = seg
             continue
         first = 0  # the ring as GEOS gives it: clockwise, from the lowest point (the leftmost of those)
         for t in range(1, nh):
@@ -278,9 +277,9 @@ def _describe_loop(pts, offsets):
         for t in range(nh):
             x1, y1, x2, y2 = p[ring[t], 0], p[ring[t], 1], p[ring[t + 1], 0], p[ring[t + 1], 1]
             a2 = (x1 - bx) * (y2 - by) - (x2 - bx) * (y1 - by)
-            sx += 1.0 * a2 * (bx + x1 + x2)
-            sy += 1.0 * a2 * (by + y1 + y2)
-            area2 += 1.0 * a2
+            sx += a2 * (bx + x1 + x2)
+            sy += a2 * (by + y1 + y2)
+            area2 += a2
         if area2 == 0.0:
             unsure[k] = True
             continue

@@ -108,19 +108,20 @@ def near_any(a: np.ndarray, b: np.ndarray, radius_m: float) -> np.ndarray:
     """Whether each point of ``a`` (shape (n, 2)) lies closer than ``radius_m`` metres to some
     point of ``b`` (shape (m, 2)), both in one frame: ``pairwise_distances(a, b).min(axis=1) <
     radius_m``, and the same answer (a compiled loop that skips the distance of a pair
-    farther apart than the radius along x or y, when numba is on and every point is finite)."""
+    farther apart than the radius along x or y, when numba is on and ``b`` holds no nan: one
+    would make numpy's minimum of every row nan, and so no point near)."""
     a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
     if not len(a) or not len(b):
         return np.zeros(len(a), dtype=bool)
-    if compiled.on and np.isfinite(a).all() and np.isfinite(b).all():
+    if compiled.on and not np.isnan(b).any():
         return _near_any_kernel(np.ascontiguousarray(a), np.ascontiguousarray(b), float(radius_m))
     return pairwise_distances(a, b).min(axis=1) < radius_m
 
 
 def _near_any_loop(a, b, radius_m):
-    """:func:`near_any` for finite points: a distance is at least its larger side, so a pair
-    that far apart along x or y is not near, and the others are measured as numpy does
-    (``hypot``)."""
+    """:func:`near_any` when ``b`` holds no nan: a distance is at least its larger side, so a
+    pair that far apart along x or y is not near (nor one with a nan in ``a``, which numpy
+    finds near nothing either), and the others are measured as numpy does (``hypot``)."""
     out = np.zeros(len(a), np.bool_)
     for i in range(len(a)):
         for j in range(len(b)):
@@ -132,3 +133,40 @@ def _near_any_loop(a, b, radius_m):
 
 
 _near_any_kernel = compiled.njit(_near_any_loop)
+
+
+def best_within(places: np.ndarray, legs: np.ndarray, scores: np.ndarray, radius_m: float) -> np.ndarray:
+    """The best of ``scores`` (one per row of ``legs``) among the legs within ``radius_m``
+    metres of each of ``places`` (both (n, 2), one frame); nan where there is none. A compiled
+    loop when numba is on and the scores are finite (a pair farther apart along x or y than
+    the radius is not within it; the others are measured with ``hypot``, as numpy does), the
+    same answers as the numpy expression, which stays the reference."""
+    out = np.full(len(places), np.nan)
+    if not len(places) or not len(legs):
+        return out
+    if compiled.on and np.isfinite(scores).all():
+        return _best_within_kernel(np.ascontiguousarray(places, dtype=np.float64),
+                                   np.ascontiguousarray(legs, dtype=np.float64),
+                                   np.ascontiguousarray(scores, dtype=np.float64), float(radius_m))
+    near = pairwise_distances(places, legs) <= radius_m
+    best = np.where(near, scores[None, :], -1.0).max(axis=1)
+    return np.where(near.any(axis=1), best, np.nan)
+
+
+def _best_within_loop(places, legs, scores, radius_m):
+    """:func:`best_within` as one compiled loop (finite scores)."""
+    out = np.full(len(places), np.nan)
+    for i in range(len(places)):
+        best, found = -1.0, False
+        for j in range(len(legs)):
+            dx, dy = places[i, 0] - legs[j, 0], places[i, 1] - legs[j, 1]
+            if abs(dx) <= radius_m and abs(dy) <= radius_m and np.hypot(dx, dy) <= radius_m:
+                found = True
+                if scores[j] > best:
+                    best = scores[j]
+        if found:
+            out[i] = best
+    return out
+
+
+_best_within_kernel = compiled.njit(_best_within_loop)

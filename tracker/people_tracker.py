@@ -24,7 +24,7 @@ from people_tracker.detection.free_space import (OCCLUDED, SEEN_THROUGH, UNSEEN,
 from people_tracker.detection.leg_features import LegCandidates, leg_candidates
 from people_tracker.models import compiled
 from people_tracker.models.leg_model import LegModel, load_leg_model
-from people_tracker.models.pose import Pose2D, pairwise_distances
+from people_tracker.models.pose import Pose2D, best_within, pairwise_distances
 from people_tracker.models.scan import Scan
 from people_tracker.tracker.association import associate, mahalanobis_costs
 from people_tracker.tracker.existence import Existence, ExistenceParams
@@ -841,44 +841,6 @@ def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:
     if not tracks:
         return np.zeros((0, 2))
     return pose.inverse().transform_points(np.array([(t.x, t.y) for t in tracks]))
-
-
-
-def best_within(places: np.ndarray, legs: np.ndarray, scores: np.ndarray, radius_m: float) -> np.ndarray:
-    """The best of ``scores`` (one per row of ``legs``) among the legs within ``radius_m``
-    metres of each of ``places`` (both (n, 2), one frame); nan where there is none. A compiled
-    loop when numba is on and the scores are finite (a pair farther apart along x or y than
-    the radius is not within it; the others are measured with ``hypot``, as numpy does), the
-    same answers as the numpy expression, which stays the reference."""
-    out = np.full(len(places), np.nan)
-    if not len(places) or not len(legs):
-        return out
-    if compiled.on and np.isfinite(scores).all():
-        return _best_within_kernel(np.ascontiguousarray(places, dtype=np.float64),
-                                   np.ascontiguousarray(legs, dtype=np.float64),
-                                   np.ascontiguousarray(scores, dtype=np.float64), float(radius_m))
-    near = pairwise_distances(places, legs) <= radius_m
-    best = np.where(near, scores[None, :], -1.0).max(axis=1)
-    return np.where(near.any(axis=1), best, np.nan)
-
-
-def _best_within_loop(places, legs, scores, radius_m):
-    """:func:`best_within` as one compiled loop (finite scores)."""
-    out = np.full(len(places), np.nan)
-    for i in range(len(places)):
-        best, found = -1.0, False
-        for j in range(len(legs)):
-            dx, dy = places[i, 0] - legs[j, 0], places[i, 1] - legs[j, 1]
-            if abs(dx) <= radius_m and abs(dy) <= radius_m and np.hypot(dx, dy) <= radius_m:
-                found = True
-                if scores[j] > best:
-                    best = scores[j]
-        if found:
-            out[i] = best
-    return out
-
-
-_best_within_kernel = compiled.njit(_best_within_loop)
 
 
 def _stance_partner_choice(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d):
