@@ -130,6 +130,9 @@ def _build_parser() -> argparse.ArgumentParser:
     tl.add_argument("--trees", type=int, default=200, help="boosting rounds (%(default)s)")
     tl.add_argument("--simulated", type=int, default=600, metavar="N",
                     help="also N scans of simulated rooms with people and furniture, every leg known (%(default)s; 0: none)")
+    tl.add_argument("--depth", type=int, default=4, help="depth of each tree (%(default)s)")
+    tl.add_argument("--simulated-resolutions", type=float, nargs="+", default=[0.25, 0.35, 0.5, 0.75], metavar="DEG",
+                    help="beam spacings of the simulated lasers, degrees (default: %(default)s)")
     ros = sub.add_parser("ros2", help="run as a live ROS 2 node ([ros2] extra): scans in, people out", parents=[common],
                          epilog="Publishes people (geometry_msgs/PoseArray), people_markers (visualization_msgs/"
                                 "MarkerArray), people_target (geometry_msgs/PoseStamped) and, with --legs, legs "
@@ -444,6 +447,10 @@ def _cmd_train_legs(args) -> int:
         raise InputError("--trees must be between 10 and 5000")
     if not 0 <= args.simulated <= 100000:
         raise InputError("--simulated must be between 0 and 100000")
+    if not 1 <= args.depth <= 12:
+        raise InputError("--depth must be between 1 and 12")
+    if not all(0.01 <= r <= 10.0 for r in args.simulated_resolutions):
+        raise InputError("--simulated-resolutions takes beam spacings between 0.01 and 10 degrees")
     positive_args = [_bag_and_topic(a) for a in args.positive]
     negative_args = [_bag_and_topic(a) for a in args.negative]
     check_outputs([b for b, _ in positive_args + negative_args], [args.output])
@@ -459,7 +466,8 @@ def _cmd_train_legs(args) -> int:
     moved = T.transplanted(positives, negatives, per_scan=2)
     x, y, groups = T.dataset(positives, negatives)
     xm, ym, gm = T.dataset(moved, [])
-    xs, ys, gs = T.dataset([T.simulated_rooms(args.simulated)] if args.simulated else [], [])
+    xs, ys, gs = T.dataset([T.simulated_rooms(args.simulated, resolutions_deg=tuple(args.simulated_resolutions))]
+                           if args.simulated else [], [])
     gs = gs + (int(groups.max(initial=0)) + 1) * T.BLOCKS  # groups of their own
     recorded = np.concatenate([np.ones(len(y), dtype=bool), np.zeros(len(ym) + len(ys), dtype=bool)])
     x, y, groups = np.vstack([x, xm, xs]), np.concatenate([y, ym, ys]), np.concatenate([groups, gm, gs])
@@ -467,7 +475,8 @@ def _cmd_train_legs(args) -> int:
           f"beam), from {sum(map(len, positives))} labelled scans, their legs pasted into "
           f"{sum(map(len, moved))} empty ones, {sum(map(len, negatives))} empty scans and {args.simulated} "
           f"simulated ones")
-    model = T.fit(x, y, groups, n_trees=args.trees, meta={"trained_on": names}, calibrate_on=recorded)
+    model = T.fit(x, y, groups, n_trees=args.trees, depth=args.depth, meta={"trained_on": names},
+                  calibrate_on=recorded)
     with atomic_output(args.output, "wb") as fh:
         model.save(fh)
     print(f"wrote {args.output} ({len(model.feature)} trees of depth {model.depth}, "

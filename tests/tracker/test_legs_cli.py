@@ -66,14 +66,18 @@ def test_train_legs_with_a_box_instead_of_labels(tmp_path):
     pos = data_file("leigh/training/positive_2.bag")  # the raw recording: no labels
     neg = data_file("leigh/negative_2.bag")
     proc = run_cli("train-legs", "--positive", str(pos), "--negative", f"{neg}:/rear_scan", "--box", "0.5", "-0.7",
-                   "5.0", "0.25", "--output", "boxed.npz", "--trees", "20", "--simulated", "0", cwd=tmp_path)
+                   "5.0", "0.25", "--output", "boxed.npz", "--trees", "20", "--simulated", "0", "--depth", "6",
+                   cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
-    assert (tmp_path / "boxed.npz").exists()
+    from people_tracker.models.leg_model import load_leg_model
+    assert load_leg_model(tmp_path / "boxed.npz").depth == 6
 
 
 @pytest.mark.parametrize("args, words", [
     (["--box", "1", "0", "0", "1"], "--box needs X0 < X1"),
     (["--trees", "3"], "--trees must be between"),
+    (["--depth", "0"], "--depth must be between"),
+    (["--simulated-resolutions", "0.5", "-1"], "--simulated-resolutions takes"),
 ])
 def test_train_legs_bad_arguments_are_one_line(tmp_path, args, words):
     pytest.importorskip("sklearn", reason="scikit-learn is the [train] extra")
