@@ -54,7 +54,7 @@ def main(argv=None) -> int:
     ap.add_argument("--depth", type=int, default=4, help="tree depth (%(default)s)")
     ap.add_argument("--trees", type=int, default=200, help="boosting rounds (%(default)s)")
     ap.add_argument("--simulated", type=int, default=600, help="simulated scans (%(default)s)")
-    ap.add_argument("--simulated-resolutions", type=float, nargs="+", default=[0.25, 0.35, 0.5, 0.75], metavar="DEG",
+    ap.add_argument("--simulated-resolutions", type=float, nargs="+", default=list(T.SIMULATED_RESOLUTIONS_DEG), metavar="DEG",
                     help="the simulated lasers' beam spacings (%(default)s)")
     args = ap.parse_args(argv)
     if not DATA.is_dir():
@@ -63,24 +63,14 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     positives = {k: T.read_labelled(DATA / "training" / f"positive_{k}_extracted.bag") for k in (1, 2, 3)}
     rooms = {t: [s for _, s in T.read_scans(DATA / "negative_2.bag", t)] for t in ("/left_scan", "/right_scan")}
-    simulated = T.dataset([T.simulated_rooms(args.simulated, resolutions_deg=tuple(args.simulated_resolutions))], []) \
-        if args.simulated else None
     print(f"depth {args.depth}, {args.trees} trees, {args.simulated} simulated scans at {args.simulated_resolutions} deg")
     print("fitted on                        scored on                        all    2nd    3rd")
     rows = []
     for held, fit_laser, score_laser in FOLDS:
         fit_on = [positives[k] for k in (1, 2, 3) if k != held]
-        x, y, g = T.dataset(fit_on, [rooms[fit_laser]])
-        xm, ym, gm = T.dataset(T.transplanted(fit_on, [rooms[fit_laser]], per_scan=2), [])
-        parts = [(x, y, g), (xm, ym, gm)]
-        if simulated is not None:
-            xs, ys, gs = simulated
-            parts.append((xs, ys, gs + (int(g.max()) + 1) * T.BLOCKS))
-        recorded = np.zeros(sum(len(p[1]) for p in parts), dtype=bool)
-        recorded[:len(y)] = True
-        model = T.fit(np.vstack([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
-                      np.concatenate([p[2] for p in parts]), n_trees=args.trees, depth=args.depth,
-                      calibrate_on=recorded)
+        x, y, groups, recorded, _ = T.training_set(fit_on, [rooms[fit_laser]], args.simulated,
+                                                   args.simulated_resolutions)
+        model = T.fit(x, y, groups, n_trees=args.trees, depth=args.depth, calibrate_on=recorded)
         r = [recall_at(model, positives[held], rooms[score_laser], every) for every in (1, 2, 3)]
         rows.append(r)
         names = "+".join(f"p{k}" for k in (1, 2, 3) if k != held)

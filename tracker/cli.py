@@ -463,17 +463,10 @@ def _cmd_train_legs(args) -> int:
         for t in ([topic] if topic else T.laser_topics(bag)):
             negatives.append([s for _, s in T.read_scans(bag, t)])
             names.append(f"{bag}:{t}")
-    moved = T.transplanted(positives, negatives, per_scan=2)
-    x, y, groups = T.dataset(positives, negatives)
-    xm, ym, gm = T.dataset(moved, [])
-    xs, ys, gs = T.dataset([T.simulated_rooms(args.simulated, resolutions_deg=tuple(args.simulated_resolutions))]
-                           if args.simulated else [], [])
-    gs = gs + (int(groups.max(initial=0)) + 1) * T.BLOCKS  # groups of their own
-    recorded = np.concatenate([np.ones(len(y), dtype=bool), np.zeros(len(ym) + len(ys), dtype=bool)])
-    x, y, groups = np.vstack([x, xm, xs]), np.concatenate([y, ym, ys]), np.concatenate([groups, gm, gs])
+    x, y, groups, recorded, moved = T.training_set(positives, negatives, args.simulated, args.simulated_resolutions)
     print(f"candidates: {int(y.sum())} legs, {int(len(y) - y.sum())} others (each scan also at every 2nd and 3rd "
           f"beam), from {sum(map(len, positives))} labelled scans, their legs pasted into "
-          f"{sum(map(len, moved))} empty ones, {sum(map(len, negatives))} empty scans and {args.simulated} "
+          f"{moved} empty ones, {sum(map(len, negatives))} empty scans and {args.simulated} "
           f"simulated ones")
     model = T.fit(x, y, groups, n_trees=args.trees, depth=args.depth, meta={"trained_on": names},
                   calibrate_on=recorded)

@@ -46,6 +46,7 @@ from people_tracker.tracker.errors import InputError, require
 LABEL_TOPIC = "/leg_cluster_positions"
 POSE_ARRAY = "geometry_msgs/msg/PoseArray"
 DECIMATIONS = ((1, 0), (2, 0), (2, 1), (3, 0), (3, 1), (3, 2))  # (every k-th beam, from beam)
+SIMULATED_RESOLUTIONS_DEG = (0.25, 0.35, 0.5, 0.75)  # the simulated rooms' lasers, degrees between beams
 BLOCKS = 5  # each recording is cut into this many stretches of time; a fold leaves whole stretches out
 
 
@@ -230,7 +231,7 @@ def people_among_furniture(laser, world, furniture: np.ndarray, rng: np.random.G
     return scan, legs[seen >= 2, :2]
 
 
-def simulated_rooms(n_scans: int, seed: int = 100, resolutions_deg=(0.25, 0.35, 0.5, 0.75)) -> list[LabelledScan]:
+def simulated_rooms(n_scans: int, seed: int = 100, resolutions_deg=SIMULATED_RESOLUTIONS_DEG) -> list[LabelledScan]:
     """Scans of randomised furnished rooms with people, every leg labelled.
 
     A new room every 10 scans: walls 6-14 by 5-12 m, two to eight tables and chairs whose
@@ -299,6 +300,24 @@ def dataset(labelled: list[list[LabelledScan]], negatives: list[list[Scan]], mat
     if not xs:
         return np.zeros((0, len(FEATURES))), np.zeros(0), np.zeros(0, dtype=np.int64)
     return np.vstack(xs), np.concatenate(ys), np.concatenate(gs)
+
+
+def training_set(positives: list[list[LabelledScan]], negatives: list[list[Scan]], simulated: int = 600,
+                 resolutions_deg=SIMULATED_RESOLUTIONS_DEG) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    """What ``people-tracker train-legs`` fits on: the labelled recordings' candidates, their
+    legs pasted into two empty rooms each, the empty rooms' candidates and ``simulated``
+    scans of simulated rooms (lasers of ``resolutions_deg``), every scan at every
+    decimation. Returns features, labels, groups (the simulated and pasted ones in groups
+    of their own), the mask of recorded examples (the calibration's) and how many pasted
+    scans there are (a scan whose legs fit no room is left out)."""
+    moved = transplanted(positives, negatives, per_scan=2)
+    x, y, groups = dataset(positives, negatives)
+    xm, ym, gm = dataset(moved, [])
+    xs, ys, gs = dataset([simulated_rooms(simulated, resolutions_deg=tuple(resolutions_deg))] if simulated else [], [])
+    gs = gs + (int(groups.max(initial=0)) + 1) * BLOCKS
+    recorded = np.concatenate([np.ones(len(y), dtype=bool), np.zeros(len(ym) + len(ys), dtype=bool)])
+    return (np.vstack([x, xm, xs]), np.concatenate([y, ym, ys]), np.concatenate([groups, gm, gs]), recorded,
+            sum(map(len, moved)))
 
 
 def _export(clf) -> tuple[np.ndarray, ...]:
