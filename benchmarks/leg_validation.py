@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from people_tracker.tracker import train_legs as T
+from people_tracker.tracker.errors import InputError, require
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh"
 FOLDS = ((3, "/left_scan", "/right_scan"), (2, "/right_scan", "/left_scan"), (1, "/left_scan", "/right_scan"))
@@ -59,6 +60,11 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if not DATA.is_dir():
         print(f"leg_validation: {DATA} not found", file=sys.stderr)
+        return 2
+    try:
+        require("sklearn", "train", "leg_validation.py")
+    except InputError as exc:
+        print(f"leg_validation: {exc}", file=sys.stderr)
         return 2
     t0 = time.perf_counter()
     positives = {k: T.read_labelled(DATA / "training" / f"positive_{k}_extracted.bag") for k in (1, 2, 3)}
