@@ -168,18 +168,25 @@ def machine() -> str:
     return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, one core used"
 
 
-def run_bench(config: Config, data: Path | None, quick: bool, out) -> None:
-    """Print the table to ``out`` (a text stream), one row as soon as it is measured."""
+def run_bench(config: Config, data: Path | None, quick: bool, out, only: list[str] | None = None) -> None:
+    """Print the table to ``out`` (a text stream), one row as soon as it is measured.
+    ``only``: just the inputs whose name (``FILE TOPIC``, ``simulated SCENE``) contains one of
+    these texts; :class:`InputError` when none does."""
     limit = 200 if quick else None
     duration = 6.0 if quick else None
+    wanted = (lambda name: any(t in name for t in only)) if only else (lambda name: True)  # noqa: E731
+    found = recordings(data) if data is not None and data.is_dir() else None
+    chosen = [(p, t) for p, t in found or [] if wanted(f"{p.name} {t}")]
+    scenes = [n for n in SCENES if wanted(f"simulated {n}")]
+    if only and not chosen and not scenes:
+        raise InputError(f"--only {' '.join(only)}: no recording or simulated scene has that in its name")
     print(f"people-tracker bench on {machine()}" + (" (quick: 200 scans, 6 s scenes)" if quick else ""), file=out)
     print(HEADER, file=out, flush=True)
-    if data is not None and data.is_dir():
-        for path, topic in recordings(data):
-            for row in bench_recording(path, topic, config, limit):
-                print(format_row(row), file=out, flush=True)
-    else:
+    if found is None:
         print(f"(no recordings: data folder {data} not found)", file=out)
-    for name in SCENES:
+    for path, topic in chosen:
+        for row in bench_recording(path, topic, config, limit):
+            print(format_row(row), file=out, flush=True)
+    for name in scenes:
         print(format_row(bench_scene(name, config, duration)), file=out, flush=True)
     print(PUBLISHED, file=out)

@@ -163,6 +163,8 @@ def _build_parser() -> argparse.ArgumentParser:
                        "else ../shared/data)")
     bench.add_argument("--config", metavar="FILE", help="YAML file overriding configs/default.yaml")
     bench.add_argument("--quick", action="store_true", help="the first 200 scans and 6 s scenes")
+    bench.add_argument("--only", nargs="+", metavar="TEXT",
+                       help="only the inputs whose name contains one of these (e.g. negative_2 crowd)")
     return p
 
 
@@ -422,7 +424,7 @@ def _cmd_bench(args) -> int:
     data = Path(args.data or os.environ.get("PEOPLE_TRACKER_DATA") or "../shared/data")
     if args.data and not data.is_dir():
         raise InputError(f"data folder '{data}' does not exist")
-    run_bench(config, data, args.quick, sys.stdout)
+    run_bench(config, data, args.quick, sys.stdout, args.only)
     return 0
 
 

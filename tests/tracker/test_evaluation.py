@@ -170,3 +170,16 @@ def test_bench_prints_one_row_per_recording_topic_and_scene(tmp_path):
         assert float(row.split()[-4]) > 0  # scans per second
     assert "Joint Leg Tracker MOTA 10.2 %" in lines[-1]
     assert run_cli("bench", "--data", str(tmp_path / "nope")).returncode == 2
+
+
+def test_bench_only_runs_the_inputs_named(tmp_path):
+    data = tmp_path / "data"
+    data.mkdir()
+    proc = run_cli("simulate", "crossing", "--output", str(data / "cross.bag"), "--format", "ros1", "--duration", "4")
+    assert proc.returncode == 0, proc.stderr
+    proc = run_cli("bench", "--quick", "--data", str(data), "--only", "cross.bag", "stop_and")
+    assert proc.returncode == 0, proc.stderr
+    rows = [ln.split()[0:2] for ln in proc.stdout.splitlines()[2:-1]]
+    assert rows == [["cross.bag", "/scan"], ["simulated", "stop_and_go"]]
+    proc = run_cli("bench", "--quick", "--data", str(data), "--only", "nowhere")
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "--only nowhere" in proc.stderr
