@@ -91,3 +91,17 @@ def test_a_bad_legs_model_in_the_configuration_is_one_line(tmp_path):
     (tmp_path / "c.yaml").write_text("legs: {model: nowhere.npz}\n")
     proc = run_cli("run", "--config", "c.yaml", cwd=tmp_path)
     assert proc.returncode == 2 and "legs.model" in proc.stderr and "does not exist" in proc.stderr
+
+
+def test_train_legs_defaults_are_the_fitting_code_s():
+    # the parser is built without importing the training code (start-up time), so its
+    # defaults are written out twice; they must stay the same
+    import inspect
+
+    from people_tracker.tracker import train_legs
+    from people_tracker.tracker.cli import _build_parser
+
+    args = _build_parser().parse_args(["train-legs", "--positive", "p.bag", "--negative", "n.bag", "--output", "m.npz"])
+    assert tuple(args.simulated_resolutions) == train_legs.SIMULATED_RESOLUTIONS_DEG
+    assert args.depth == inspect.signature(train_legs.fit).parameters["depth"].default
+    assert args.trees == inspect.signature(train_legs.fit).parameters["n_trees"].default
