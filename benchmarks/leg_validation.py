@@ -35,21 +35,6 @@ DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh"
 FOLDS = ((3, "/left_scan", "/right_scan"), (2, "/right_scan", "/left_scan"), (1, "/left_scan", "/right_scan"))
 
 
-def recall_at(model, labelled, empty, every: int, false_per_scan: float = 0.5) -> float:
-    """Share of the labelled legs found at the raw-score threshold that leaves
-    ``false_per_scan`` candidates per ``empty`` scan (both at every ``every``-th beam)."""
-    empty_scores = np.concatenate([model.log_odds(T.leg_candidates(T.decimate(s, every)).features) for s in empty])
-    k = int(round(false_per_scan * len(empty)))
-    threshold = np.nextafter(np.sort(empty_scores)[::-1][k - 1], np.inf)
-    hits = total = 0
-    for item in labelled:
-        c = T.leg_candidates(T.decimate(item.scan, every))
-        keep = model.log_odds(c.features) >= threshold
-        hits += int(T.match(c.xy[keep], item.legs, 0.15)[1].sum())
-        total += len(item.legs)
-    return hits / max(total, 1)
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--depth", type=int, default=4, help="tree depth (%(default)s)")
@@ -77,7 +62,8 @@ def main(argv=None) -> int:
         x, y, groups, recorded, _ = T.training_set(fit_on, [rooms[fit_laser]], args.simulated,
                                                    args.simulated_resolutions)
         model = T.fit(x, y, groups, n_trees=args.trees, depth=args.depth, calibrate_on=recorded)
-        r = [recall_at(model, positives[held], rooms[score_laser], every) for every in (1, 2, 3)]
+        r = [T.recall_at_false_rates(model, positives[held], rooms[score_laser], (0.5,), every=every, raw=True)[0]["recall"]
+             for every in (1, 2, 3)]
         rows.append(r)
         names = "+".join(f"p{k}" for k in (1, 2, 3) if k != held)
         print(f"{names + ' ' + fit_laser:<32} {f'p{held} ' + score_laser:<32} " + " ".join(f"{v:.3f}" for v in r))

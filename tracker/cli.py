@@ -437,8 +437,6 @@ def _bag_and_topic(arg: str) -> tuple[str, str | None]:
 
 
 def _cmd_train_legs(args) -> int:
-    import numpy as np
-
     from people_tracker.tracker import train_legs as T
     from people_tracker.tracker.io.atomic import atomic_output, check_outputs
 

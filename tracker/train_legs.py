@@ -403,21 +403,30 @@ def leg_scores(model: LegModel, scan: Scan) -> tuple[np.ndarray, np.ndarray]:
 
 def recall_at_false_rates(model: LegModel, labelled: list[LabelledScan], empty: list[Scan],
                           false_per_scan=(0.2, 0.5, 1.0), match_radius_m: float = 0.15,
-                          every: int = 1) -> list[dict]:
+                          every: int = 1, raw: bool = False) -> list[dict]:
     """Leg detection scored per labelled leg: found when a candidate at or above the
     threshold lies within ``match_radius_m`` of it (one candidate per leg). The threshold
     for each rate is the score above which the ``empty`` scans (nobody there) hold that
-    many candidates per scan. ``every`` > 1 drops beams from every scan first."""
-    empty_scores = np.concatenate([leg_scores(model, decimate(s, every))[1] for s in empty] or [np.zeros(0)])
-    found = [(leg_scores(model, decimate(item.scan, every)), item.legs) for item in labelled]
+    many candidates per scan. ``every`` > 1 drops beams from every scan first. ``raw``:
+    rank by the ensemble's log-odds instead of the calibrated probability (whose map is a
+    staircase, so models that rank alike can differ by a step)."""
+    score = model.log_odds if raw else model.probability
+    lowest, highest = (-np.inf, np.inf) if raw else (0.0, 1.0)
+
+    def scored(scan: Scan) -> tuple[np.ndarray, np.ndarray]:
+        c = leg_candidates(decimate(scan, every))
+        return c.xy, score(c.features)
+
+    empty_scores = np.concatenate([scored(s)[1] for s in empty] or [np.zeros(0)])
+    found = [(scored(item.scan), item.legs) for item in labelled]
     n_legs = sum(len(legs) for _, legs in found)
     out = []
     for rate in false_per_scan:
         k = int(round(rate * len(empty)))
         ranked = np.sort(empty_scores)[::-1]
-        threshold = float(np.nextafter(ranked[k - 1], 1.0)) if 0 < k <= len(ranked) else (0.0 if k else 1.0)
+        threshold = float(np.nextafter(ranked[k - 1], highest)) if 0 < k <= len(ranked) else (lowest if k else highest)
         if k > len(ranked):
-            threshold = 0.0
+            threshold = lowest
         hits = 0
         for (xy, p), legs in found:
             hits += int(match(xy[p >= threshold], legs, match_radius_m)[1].sum())
