@@ -26,9 +26,12 @@ SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[Heal
 
 
 def spinning_scanner(fov_deg: float, res_deg: float, clockwise: bool, centre: float, rate_hz: float):
-    """angle_min, angle_increment, beam count and time_increment of a spinning scanner."""
+    """angle_min, angle_increment, beam count and time_increment of a spinning scanner.
+
+    A field within one beam spacing of 360 deg is a full turn: a scanner does not fire a
+    beam that overlaps its first one (such a beam's bearing is nearer beam 0 than itself)."""
     fov, res = math.radians(fov_deg), math.radians(res_deg)
-    full = fov >= TWO_PI - 1e-9
+    full = fov > TWO_PI - res - 1e-9
     n = int(round(TWO_PI / res)) if full else int(round(fov / res)) + 1
     step = TWO_PI / n if full else fov / (n - 1)
     span = step * (n - 1)
