@@ -199,6 +199,7 @@ class MovingObjectDetector:
     def __init__(self, params: DetectorParams | None = None) -> None:
         self.params = params or DetectorParams()
         self._history: deque[_Past] = deque()
+        self._index_history()
         self._next_id = 1
         # also the free-space lookbacks of the tracker (up to 1.5 s)
         self._keep_s = max(1.5 * max(self.params.compare_dt_s), max(self.params.static_memory_s)) + 1.5
@@ -206,6 +207,7 @@ class MovingObjectDetector:
     def reset(self) -> None:
         """Forget the history (after a stamp jump or a change of scanner)."""
         self._history.clear()
+        self._index_history()
 
     def earlier_scans(self, stamp: float, lookbacks_s: tuple[float, ...]) -> list[tuple[Scan, Pose2D, np.ndarray]]:
         """For each lookback, the kept scan nearest ``stamp - lookback`` (at least half that
@@ -217,18 +219,26 @@ class MovingObjectDetector:
             out.append((best.scan, best.pose, moving))
         return out
 
+    def _index_history(self) -> None:
+        """The kept scans' stamps (s) and whether each has a pose, as arrays for the lookbacks."""
+        self._stamps = np.array([p.scan.stamp for p in self._history], dtype=float)
+        self._posed = np.array([p.pose is not None for p in self._history], dtype=bool)
+
     def _lookback(self, stamp: float, lookbacks_s: tuple[float, ...], need_pose: bool) -> list[_Past]:
         """For each lookback, the kept scan nearest ``stamp - lookback`` and at least half
-        that long ago; each scan once."""
+        that long ago (of equally near ones the oldest); each scan once."""
         out: list[_Past] = []
+        if not len(self._stamps):
+            return out
+        age = stamp - self._stamps
         for lookback in lookbacks_s:
-            best = None
-            for past in self._history:
-                age = stamp - past.scan.stamp
-                if age >= 0.5 * lookback and (past.pose is not None or not need_pose) and (
-                        best is None or abs(age - lookback) < abs(stamp - best.scan.stamp - lookback)):
-                    best = past
-            if best is not None and all(best is not o for o in out):
+            ok = age >= 0.5 * lookback
+            if need_pose:
+                ok &= self._posed
+            if not ok.any():
+                continue
+            best = self._history[int(np.argmin(np.where(ok, np.abs(age - lookback), np.inf)))]
+            if all(best is not o for o in out):
                 out.append(best)
         return out
 
@@ -289,7 +299,7 @@ class MovingObjectDetector:
         """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""
         if not self._history:
             return []
-        stamps = np.array([p.scan.stamp for p in self._history])
+        stamps = self._stamps
         chosen = []
         for dt in self.params.compare_dt_s:
             k = int(np.argmin(np.abs(stamps - (stamp - dt))))
@@ -320,6 +330,7 @@ class MovingObjectDetector:
         self._history.append(current)
         while self._history and self._history[0].scan.stamp < scan.stamp - self._keep_s:
             self._history.popleft()
+        self._index_history()
         if not earlier:
             return Detection(np.where(scan.valid, OUT_OF_VIEW, INVALID).astype(np.int8), [], ())
         pairs = []

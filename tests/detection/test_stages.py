@@ -140,6 +140,48 @@ def test_detector_finds_an_object_that_appears_and_keeps_history_by_time():
 
 
 
+def test_lookbacks_take_the_nearest_kept_scan_oldest_first_each_once():
+    """``_lookback``: per lookback, of the kept scans at least half that long ago (with a
+    pose when asked), the one nearest ``stamp - lookback``, the oldest of equally near
+    ones; a scan chosen once. Checked against the plain loop over the history on random
+    ones, and on one by hand (stamps in eighths of a second: exact in binary)."""
+    def reference(history, stamp, lookbacks, need_pose):
+        out = []
+        for lookback in lookbacks:
+            best = None
+            for past in history:
+                age = stamp - past.scan.stamp
+                if age >= 0.5 * lookback and (past.pose is not None or not need_pose) and (
+                        best is None or abs(age - lookback) < abs(stamp - best.scan.stamp - lookback)):
+                    best = past
+            if best is not None and all(best is not o for o in out):
+                out.append(best)
+        return out
+
+    det = MovingObjectDetector(DetectorParams(compare_dt_s=(0.125,)))
+    for k, t in enumerate((0.0, 0.125, 0.25, 0.375, 0.625, 0.875, 1.0)):
+        det.detect(_wall_scan(t), Pose2D() if k != 5 else None)
+    stamps = [p.scan.stamp for p in det._lookback(1.0, (0.25, 0.5, 0.625), need_pose=False)]
+    assert stamps == [0.625, 0.375]  # 0.25: 0.125 s and 0.375 s ago tie, the older; 0.5 too; 0.625: taken
+    assert [p.scan.stamp for p in det._lookback(1.0, (0.125,), need_pose=False)] == [0.875]
+    assert [p.scan.stamp for p in det._lookback(1.0, (0.125,), need_pose=True)] == [0.625]  # 0.875 has no pose
+    assert det._lookback(1.0, (5.0,), need_pose=False) == []
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        det = MovingObjectDetector(DetectorParams(compare_dt_s=(0.1,)))
+        t = 0.0
+        for _ in range(rng.integers(1, 40)):
+            t += float(rng.choice([0.05, 0.1, 0.1, 0.2]))
+            det.detect(_wall_scan(t), Pose2D() if rng.random() < 0.8 else None)
+        for need_pose in (False, True):
+            lookbacks = tuple(rng.uniform(0.05, 2.0, size=3))
+            got = det._lookback(t + 0.1, lookbacks, need_pose)
+            want = reference(det._history, t + 0.1, lookbacks, need_pose)
+            assert len(got) == len(want) and all(a is b for a, b in zip(got, want))
+    det.reset()
+    assert det._lookback(1.0, (0.25,), need_pose=False) == []
+
+
 def test_free_space_sees_through_empty_places_only():
     from people_tracker.detection.free_space import seen_through
     ranges = np.array([5.0, np.inf, np.nan, 2.0, 2.0, 0.0])

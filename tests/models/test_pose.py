@@ -34,3 +34,16 @@ def test_interpolation_takes_the_short_way_round():
 def test_yaw_from_quaternion():
     for yaw in (-3.0, -1.0, 0.0, 0.5, 3.1):
         assert yaw_from_quaternion(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)) == pytest.approx(yaw)
+
+
+def test_transform_points_gives_the_same_bits_compiled_and_in_numpy():
+    from people_tracker.models import compiled
+    rng = np.random.default_rng(3)
+    for n in (0, 1, 7, 900):
+        p, pts = Pose2D(*rng.normal(size=3) * 5), rng.normal(size=(n, 2)) * 10
+        fast = p.transform_points(pts)
+        with compiled.numpy_only():
+            ref = p.transform_points(pts)
+        assert fast.shape == ref.shape == (n, 2) and np.array_equal(fast, ref)
+    # one point as a 1-D array, and integer input
+    np.testing.assert_allclose(Pose2D(1.0, 2.0, math.pi / 2).transform_points(np.array([1, 0])), [1.0, 3.0], atol=1e-12)
