@@ -16,7 +16,7 @@ from scipy.linalg.lapack import dsyev
 from people_tracker.detection.kdtree import PointTree
 from people_tracker.models import compiled
 from people_tracker.models.compiled import njit
-from people_tracker.models.pose import Pose2D, wrap_angle
+from people_tracker.models.pose import Pose2D, rotate_translate, wrap_angle
 
 
 @dataclass(frozen=True)
@@ -192,7 +192,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
     it = 0
     for it in range(1, params.max_iterations + 1):
         c, s = math.cos(th), math.sin(th)
-        p = src @ np.array([[c, s], [-s, c]]) + (x, y)  # R p + t, in the reference frame
+        p = rotate_translate(src, c, s, x, y)  # R p + t, in the reference frame
         _, j = reference.tree.query(p, gate)
         if compiled.on:  # the pairs, their trimming and the Jacobian as one compiled loop
             n_found, p, r, A = _pairs_kernel(p, j, reference.usable_or_none, reference.points, reference.normals,

@@ -77,20 +77,27 @@ class Pose2D:
         ``x' = (x c - y s) + t_x``, ``y' = (x s + y c) + t_y``, in that order, element by
         element: the same bits from the compiled loop as from numpy, and on every machine
         (a matrix product goes through the BLAS, whose kernels differ from CPU to CPU)."""
-        pts = np.asarray(points, dtype=np.float64)
         c, s = self._cos_sin
-        if compiled.on and pts.ndim == 2 and pts.shape[1] == 2:
-            return _transform_kernel(np.ascontiguousarray(pts), c, s, float(self.x), float(self.y))
-        x, y = pts[..., 0], pts[..., 1]
-        out = np.empty(np.broadcast_shapes(pts.shape, (2,)))
-        out[..., 0] = x * c - y * s + self.x
-        out[..., 1] = x * s + y * c + self.y
-        return out
+        return rotate_translate(points, c, s, self.x, self.y)
 
     def as_matrix(self) -> np.ndarray:
         """Homogeneous 3x3 matrix of this pose."""
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         return np.array([[c, -s, self.x], [s, c, self.y], [0.0, 0.0, 1.0]])
+
+
+def rotate_translate(points: np.ndarray, c: float, s: float, tx: float, ty: float) -> np.ndarray:
+    """Points (n, 2) rotated by the angle of cosine ``c`` and sine ``s`` and moved by
+    (``tx``, ``ty``) metres: :meth:`Pose2D.transform_points`' arithmetic, for callers that
+    hold the cosine and sine already (the scan matcher's iterations)."""
+    pts = np.asarray(points, dtype=np.float64)
+    if compiled.on and pts.ndim == 2 and pts.shape[1] == 2:
+        return _transform_kernel(np.ascontiguousarray(pts), float(c), float(s), float(tx), float(ty))
+    x, y = pts[..., 0], pts[..., 1]
+    out = np.empty(np.broadcast_shapes(pts.shape, (2,)))
+    out[..., 0] = x * c - y * s + tx
+    out[..., 1] = x * s + y * c + ty
+    return out
 
 
 def _transform_loop(pts, c, s, tx, ty):

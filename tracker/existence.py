@@ -154,9 +154,20 @@ class Existence:
         self.stamp = stamp
 
     @property
-    def l_shape(self) -> float:
+    def shape_p(self) -> float:
+        """The leg-shape probability averaged over ``shape_time_s``."""
+        return self._shape_p
+
+    @shape_p.setter
+    def shape_p(self, value: float) -> None:
         p = self.params
-        return min(max(logit(self.shape_p) - self.base, math.log(p.min_shape_lr)), math.log(p.max_shape_lr))
+        self._shape_p = value
+        # the shape term, worked out once per change (it is read several times a scan)
+        self._l_shape = min(max(logit(value) - self.base, math.log(p.min_shape_lr)), math.log(p.max_shape_lr))
+
+    @property
+    def l_shape(self) -> float:
+        return self._l_shape
 
     @property
     def probability(self) -> float:
