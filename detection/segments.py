@@ -41,7 +41,8 @@ def split_runs(labels: np.ndarray, points: np.ndarray, gap_threshold: np.ndarray
     if len(labels) == 0:
         return []
     bounds = run_bounds(points, gap_threshold, labels)
-    return [Segment(int(a), int(b), int(labels[a]), (int(labels[a]),)) for a, b in zip(bounds[:-1], bounds[1:])]
+    starts, stops, first = bounds[:-1].tolist(), bounds[1:].tolist(), labels[bounds[:-1]].tolist()  # Python ints
+    return [Segment(a, b, lab, (lab,)) for a, b, lab in zip(starts, stops, first)]
 
 
 def run_bounds(points: np.ndarray, gap_threshold: np.ndarray, labels: np.ndarray | None = None) -> np.ndarray:

@@ -98,8 +98,9 @@ class PersonCandidate:
 
     @property
     def R(self) -> np.ndarray:
-        """Measurement covariance, m²."""
-        return np.eye(2) * self.sigma ** 2
+        """Measurement covariance, m² (``np.eye(2) * sigma²``, without making the identity)."""
+        v = self.sigma ** 2
+        return np.array([[v, 0.0], [0.0, v]])
 
 
 def leg_centres(means: np.ndarray, widths: np.ndarray, max_radius_m: float) -> np.ndarray:
