@@ -18,7 +18,7 @@ from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VI
 from people_tracker.detection.objects import MovingObject, describe_all
 from people_tracker.detection.recover import isolated_occluded, recover_moving
 from people_tracker.detection.scan_lines import bin_to_beams, line_labels_kernel, scan_line_labels
-from people_tracker.detection.segments import split_runs
+from people_tracker.detection.segments import means_and_chords, split_runs
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D, pairwise_distances
@@ -260,7 +260,7 @@ class MovingObjectDetector:
             keep &= ~self._carried(scan, pose, spans, pts, ranges, memory)
         test = np.arange(len(spans))
         if people is not None and len(people):
-            xy = np.array([pts[a:b].mean(axis=0) for a, b in spans])
+            xy = means_and_chords([pts[a:b] for a, b in spans])[0]
             d = pairwise_distances(xy, people).min(axis=1)
             test = test[d > p.static_memory_keep_m]
         if not len(test):

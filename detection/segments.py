@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from people_tracker.models import compiled
+
 
 @dataclass
 class Segment:
@@ -57,3 +59,37 @@ def run_bounds(points: np.ndarray, gap_threshold: np.ndarray, labels: np.ndarray
     if labels is not None:
         cut |= labels[1:] != labels[:-1]
     return np.concatenate([[0], np.flatnonzero(cut) + 1, [n]])
+
+
+def means_and_chords(groups: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """For each group of readings (shape (k, 2), k >= 1, metres): its mean, and the distance
+    from its first reading to its last (the chord a leg's arc spans), as
+    ``g.mean(axis=0)`` and ``np.hypot(*(g[-1] - g[0]))`` give them; shapes (n, 2) and (n,)."""
+    if not groups:
+        return np.zeros((0, 2)), np.zeros(0)
+    if compiled.on:
+        offsets = np.zeros(len(groups) + 1, np.int64)
+        np.cumsum([len(g) for g in groups], out=offsets[1:])
+        return _means_chords_kernel(np.concatenate(groups), offsets)
+    return (np.array([g.mean(axis=0) for g in groups]),
+            np.array([np.hypot(*(g[-1] - g[0])) for g in groups]))
+
+
+def _means_chords_loop(pts, offsets):
+    """:func:`means_and_chords` of the groups ``pts[offsets[k]:offsets[k + 1]]``: a group's
+    mean summed as numpy sums a (k, 2) array down its rows (the first row, then each in turn)."""
+    n = len(offsets) - 1
+    means = np.empty((n, 2))
+    chords = np.empty(n)
+    for k in range(n):
+        a, b = offsets[k], offsets[k + 1]
+        sx, sy = pts[a, 0], pts[a, 1]
+        for i in range(a + 1, b):
+            sx += pts[i, 0]
+            sy += pts[i, 1]
+        means[k, 0], means[k, 1] = sx / (b - a), sy / (b - a)
+        chords[k] = np.hypot(pts[b - 1, 0] - pts[a, 0], pts[b - 1, 1] - pts[a, 1])
+    return means, chords
+
+
+_means_chords_kernel = compiled.njit(_means_chords_loop)

@@ -22,6 +22,7 @@ from people_tracker.detection import labels as L
 from people_tracker.detection.free_space import (OCCLUDED, SEEN_THROUGH, UNSEEN, PlaceMemory, place_visibility,
                                                  seen_through)
 from people_tracker.detection.leg_features import LegCandidates, leg_candidates
+from people_tracker.detection.segments import means_and_chords
 from people_tracker.models import compiled
 from people_tracker.models.leg_model import LegModel, load_leg_model
 from people_tracker.models.pose import Pose2D, best_within, pairwise_distances
@@ -386,9 +387,8 @@ class PeopleTracker:
         if not objs:
             return []
         if self.pairing.max_leg_radius_m > 0:  # leg centres, behind the readings
-            widths = np.array([np.hypot(*(o.points[-1] - o.points[0])) for o in objs])
-            xy = world.transform_points(leg_centres(np.array([o.points.mean(axis=0) for o in objs]), widths,
-                                                    self.pairing.max_leg_radius_m))
+            means, widths = means_and_chords([o.points for o in objs])
+            xy = world.transform_points(leg_centres(means, widths, self.pairing.max_leg_radius_m))
         else:
             xy = world.transform_points(np.array([(o.x, o.y) for o in objs]))
         # legs near a tracked walking person are that person's: never paired with another

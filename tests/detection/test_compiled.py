@@ -212,6 +212,21 @@ def test_near_any_agrees_with_the_distance_matrix():
     assert near > 1000
 
 
+def test_group_means_and_chords_agree():
+    """The moving objects' means and end-to-end chords (the leg centres' input), and the
+    static memory's object means: the compiled sums down the rows are numpy's."""
+    from people_tracker.detection.segments import means_and_chords
+    rng = np.random.default_rng(12)
+    for k in range(500):
+        groups = [rng.normal(size=(int(rng.integers(1, 300)), 2)) * rng.uniform(0.01, 30) + rng.uniform(-20, 20, 2)
+                  for _ in range(int(rng.integers(1, 40)))]
+        fast = means_and_chords(groups)
+        with compiled.numpy_only():
+            ref = means_and_chords(groups)
+        assert fast[0].tobytes() == ref[0].tobytes() and fast[1].tobytes() == ref[1].tobytes(), k
+    assert [a.shape for a in means_and_chords([])] == [(0, 2), (0,)]
+
+
 def test_best_leg_within_a_radius_agrees():
     from people_tracker.models.pose import best_within
     rng = np.random.default_rng(10)
