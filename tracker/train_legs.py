@@ -395,10 +395,11 @@ def fit(x: np.ndarray, y: np.ndarray, groups: np.ndarray, n_trees: int = 200, de
                     float(np.ravel(clf._baseline_prediction)[0]), calib_raw, calib_p, info)
 
 
-def leg_scores(model: LegModel, scan: Scan) -> tuple[np.ndarray, np.ndarray]:
-    """Candidate positions (sensor frame, m, shape (k, 2)) and their probabilities of being a leg."""
-    c = leg_candidates(scan)
-    return c.xy, model.probability(c.features)
+def leg_scores(model: LegModel, scan: Scan, every: int = 1, raw: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Candidate positions (sensor frame, m, shape (k, 2)) and their probabilities of being a
+    leg (``raw``: the ensemble's log-odds), with every ``every``-th beam of the scan kept."""
+    c = leg_candidates(decimate(scan, every))
+    return c.xy, (model.log_odds if raw else model.probability)(c.features)
 
 
 def recall_at_false_rates(model: LegModel, labelled: list[LabelledScan], empty: list[Scan],
@@ -410,23 +411,16 @@ def recall_at_false_rates(model: LegModel, labelled: list[LabelledScan], empty: 
     many candidates per scan. ``every`` > 1 drops beams from every scan first. ``raw``:
     rank by the ensemble's log-odds instead of the calibrated probability (whose map is a
     staircase, so models that rank alike can differ by a step)."""
-    score = model.log_odds if raw else model.probability
     lowest, highest = (-np.inf, np.inf) if raw else (0.0, 1.0)
-
-    def scored(scan: Scan) -> tuple[np.ndarray, np.ndarray]:
-        c = leg_candidates(decimate(scan, every))
-        return c.xy, score(c.features)
-
-    empty_scores = np.concatenate([scored(s)[1] for s in empty] or [np.zeros(0)])
-    found = [(scored(item.scan), item.legs) for item in labelled]
+    empty_scores = np.concatenate([leg_scores(model, s, every, raw)[1] for s in empty] or [np.zeros(0)])
+    found = [(leg_scores(model, item.scan, every, raw), item.legs) for item in labelled]
     n_legs = sum(len(legs) for _, legs in found)
+    ranked = np.sort(empty_scores)[::-1]
     out = []
     for rate in false_per_scan:
         k = int(round(rate * len(empty)))
-        ranked = np.sort(empty_scores)[::-1]
+        # past the last empty-room candidate every score passes; no false legs allowed, none does
         threshold = float(np.nextafter(ranked[k - 1], highest)) if 0 < k <= len(ranked) else (lowest if k else highest)
-        if k > len(ranked):
-            threshold = lowest
         hits = 0
         for (xy, p), legs in found:
             hits += int(match(xy[p >= threshold], legs, match_radius_m)[1].sum())
