@@ -60,6 +60,20 @@ def _row(name: str, seconds: list[float], extra: str = "") -> None:
     print(f"{name:<44} {1e3 / ms.mean():>8.0f} {np.percentile(ms, 50):>8.2f} {np.percentile(ms, 99):>8.2f}  {extra}")
 
 
+def recording_steps(path: Path, config) -> list[tuple]:
+    """Every usable scan of a recording with its poses, read first: the arguments of
+    :meth:`PeopleTracker.step`, so a timing leaves the reading out."""
+    with Recording(path, None, config.odometry) as rec:
+        return [(r.scan, r.pose, r.pose_last_beam) for r in rec.scans() if r.scan is not None]
+
+
+def crowd_steps(people: int, scans: int) -> list[tuple]:
+    """The first ``scans`` scans of the crowd scene with ``people`` walkers, rendered first,
+    as :meth:`PeopleTracker.step`'s arguments."""
+    sim, n = build_simulation(load_scenario("crowd"), crowd_count=people)
+    return [(st.scan, st.odom_pose, st.odom_pose_last_beam) for st in (sim.step() for _ in range(min(n, scans)))]
+
+
 def bench_recording(path: Path, config) -> tuple[list[float], float]:
     tracker = PeopleTracker.from_config(config)
     times, people = [], 0

@@ -31,14 +31,12 @@ import types
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_pipeline import DATA, _one_core  # noqa: E402
+from bench_pipeline import DATA, _one_core, crowd_steps, recording_steps  # noqa: E402
 
 from people_tracker.detection import kdtree, objects  # noqa: E402
 from people_tracker.models import compiled  # noqa: E402
-from people_tracker.models.scenario import build_simulation, load_scenario  # noqa: E402
 from people_tracker.tracker import static_support  # noqa: E402
 from people_tracker.tracker.config import load_config  # noqa: E402
-from people_tracker.tracker.io.recording import Recording  # noqa: E402
 from people_tracker.tracker.people_tracker import PeopleTracker, warm_up_kernels  # noqa: E402
 
 _ALL_BACKENDS = kdtree.BACKENDS
@@ -102,15 +100,10 @@ def main(argv=None) -> int:
     same = []
     bag = DATA / "general_tracking_moving_1.bag"
     if bag.exists():
-        with Recording(bag, None, config.odometry) as rec:
-            items = [(r.scan, r.pose, r.pose_last_beam) for r in rec.scans() if r.scan is not None][:args.scans]
-        same.append(compare(bag.name, config, items, args.passes))
+        same.append(compare(bag.name, config, recording_steps(bag, config)[:args.scans], args.passes))
     else:
         print(f"({bag} not found: the real recording is left out)")
-    sim, n = build_simulation(load_scenario("crowd"), crowd_count=50)
-    steps = [sim.step() for _ in range(min(n, args.crowd_scans))]
-    same.append(compare("crowd of 50", config, [(s.scan, s.odom_pose, s.odom_pose_last_beam) for s in steps],
-                        args.passes))
+    same.append(compare("crowd of 50", config, crowd_steps(50, args.crowd_scans), args.passes))
     print("every variant reported the same tracks:", "yes" if all(same) else "NO")
     return 0 if all(same) else 1
 

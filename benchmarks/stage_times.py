@@ -27,14 +27,12 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_pipeline import DATA, _one_core  # noqa: E402
+from bench_pipeline import DATA, _one_core, crowd_steps, recording_steps  # noqa: E402
 
 from people_tracker.detection import align as align_mod  # noqa: E402
 from people_tracker.detection import detector  # noqa: E402
-from people_tracker.models.scenario import build_simulation, load_scenario  # noqa: E402
 from people_tracker.tracker import people_tracker as pt  # noqa: E402
 from people_tracker.tracker.config import load_config  # noqa: E402
-from people_tracker.tracker.io.recording import Recording  # noqa: E402
 from people_tracker.tracker.people_tracker import PeopleTracker, warm_up_kernels  # noqa: E402
 
 TRACKER_STAGES = ("_candidates", "_receding", "_associate", "_recover", "_standing_candidates", "_update_standing",
@@ -119,14 +117,10 @@ def main(argv=None) -> int:
     instrument(PeopleTracker.from_config(config))
     bag = DATA / "general_tracking_moving_1.bag"
     if bag.exists():
-        with Recording(bag, None, config.odometry) as rec:
-            items = [(r.scan, r.pose, r.pose_last_beam) for r in rec.scans() if r.scan is not None]
-        run(bag.name, items, config)
+        run(bag.name, recording_steps(bag, config), config)
     else:
         print(f"({bag} not found: the real recording is left out)")
-    sim, n = build_simulation(load_scenario("crowd"), crowd_count=args.people)
-    steps = [sim.step() for _ in range(min(n, args.scans))]
-    run(f"crowd of {args.people}", [(s.scan, s.odom_pose, s.odom_pose_last_beam) for s in steps], config)
+    run(f"crowd of {args.people}", crowd_steps(args.people, args.scans), config)
     return 0
 
 

@@ -30,11 +30,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_pipeline import DEFAULT_BAG, _one_core  # noqa: E402
+from bench_pipeline import DEFAULT_BAG, _one_core, crowd_steps, recording_steps  # noqa: E402
 
-from people_tracker.models.scenario import build_simulation, load_scenario  # noqa: E402
 from people_tracker.tracker.config import load_config  # noqa: E402
-from people_tracker.tracker.io.recording import Recording  # noqa: E402
 from people_tracker.tracker.people_tracker import PeopleTracker  # noqa: E402
 
 SKIP = 3  # the first scans load the compiled kernels
@@ -63,17 +61,10 @@ def main() -> int:
     config = load_config()
     inputs = []
     if DEFAULT_BAG.exists():
-        with Recording(DEFAULT_BAG, None, config.odometry) as rec:
-            inputs.append((DEFAULT_BAG.name, [(r.scan, r.pose, r.pose_last_beam) for r in rec.scans()
-                                              if r.scan is not None]))
+        inputs.append((DEFAULT_BAG.name, recording_steps(DEFAULT_BAG, config)))
     else:
         print(f"(skipping the recording: {DEFAULT_BAG} not found)")
-    sim, n = build_simulation(load_scenario("crowd"), crowd_count=args.people)
-    crowd = []
-    for _ in range(min(n, args.scans)):
-        st = sim.step()
-        crowd.append((st.scan, st.odom_pose, st.odom_pose_last_beam))
-    inputs.append((f"crowd of {args.people}", crowd))
+    inputs.append((f"crowd of {args.people}", crowd_steps(args.people, args.scans)))
     print(f"{'input':<32} {'scans':>6} {'ms/scan':>8}   (each scan's fastest of {args.passes} passes; each pass's mean)")
     for name, steps in inputs:
         best, means = fastest_per_scan(steps, config, args.passes)
