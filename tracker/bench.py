@@ -174,7 +174,10 @@ def run_bench(config: Config, data: Path | None, quick: bool, out, only: list[st
     these texts; :class:`InputError` when none does."""
     limit = 200 if quick else None
     duration = 6.0 if quick else None
-    wanted = (lambda name: any(t in name for t in only)) if only else (lambda name: True)  # noqa: E731
+
+    def wanted(name: str) -> bool:
+        return not only or any(t in name for t in only)
+
     found = recordings(data) if data is not None and data.is_dir() else None
     chosen = [(p, t) for p, t in found or [] if wanted(f"{p.name} {t}")]
     scenes = [n for n in SCENES if wanted(f"simulated {n}")]
