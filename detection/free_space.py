@@ -149,6 +149,7 @@ class PlaceMemory:
         from collections import deque
         self.keyframe_s = keyframe_s
         self._frames: deque = deque(maxlen=max(1, int(round(memory_s / keyframe_s))) if keyframe_s > 0 else 1)
+        self._xy: np.ndarray | None = None  # the keyframes' sensor positions (see _positions)
 
     def add(self, scan: Scan, pose: Pose2D) -> None:
         """Offer a scan (sensor pose in the world frame); kept when a keyframe is due."""
@@ -157,6 +158,7 @@ class PlaceMemory:
         if not self._frames or scan.stamp - self._frames[-1][0].stamp >= self.keyframe_s or \
                 scan.stamp < self._frames[-1][0].stamp:
             self._frames.append((scan, pose))
+            self._xy = None
 
     def history(self, xy_world: np.ndarray, before_s: float, radius_m: float,
                 no_return_free_m: float = np.inf, min_occupied_s: float = 10.0) -> str:
@@ -164,16 +166,38 @@ class PlaceMemory:
         of ``radius_m`` around the place, else ``OCCUPIED_ONLY`` when keyframes worth at
         least ``min_occupied_s`` of time saw a return in it (a person passing by does not
         make a place occupied), else ``UNKNOWN`` (never in view, or mostly hidden)."""
-        occupied = 0
-        point = np.asarray(xy_world, dtype=float).reshape(1, 2)
-        for scan, pose in self._frames:
-            if scan.stamp >= before_s:
+        return self.histories(np.asarray(xy_world, dtype=float).reshape(1, 2), before_s, radius_m,
+                              no_return_free_m, min_occupied_s)[0]
+
+    def histories(self, xy_world: np.ndarray, before_s: float, radius_m: float,
+                  no_return_free_m: float = np.inf, min_occupied_s: float = 10.0,
+                  viewpoint: np.ndarray | None = None, viewpoint_radius_m: float = np.inf) -> list[str]:
+        """:meth:`history` of each of several places (shape (k, 2), world frame, m), one pass
+        over the keyframes; with ``viewpoint`` (a sensor position, world frame, m), only of
+        the keyframes taken within ``viewpoint_radius_m`` of it."""
+        points = np.asarray(xy_world, dtype=float).reshape(-1, 2)
+        empty = np.zeros(len(points), dtype=bool)
+        occupied = np.zeros(len(points), dtype=np.int64)
+        frames = list(self._frames)
+        if viewpoint is not None and frames:
+            near = np.hypot(*(self._positions() - np.asarray(viewpoint, dtype=float)).T) <= viewpoint_radius_m
+            frames = [f for f, ok in zip(frames, near) if ok]
+        for scan, pose in frames:
+            if scan.stamp >= before_s or empty.all():
                 break
-            code = place_visibility(point, scan, pose, radius_m, no_return_free_m)[0]
-            if code == SEEN_THROUGH:
-                return self.EMPTY
-            occupied += code == OCCUPIED
-        return self.OCCUPIED_ONLY if occupied * self.keyframe_s >= min_occupied_s else self.UNKNOWN
+            open_ = np.flatnonzero(~empty)
+            code = place_visibility(points[open_], scan, pose, radius_m, no_return_free_m)
+            empty[open_[code == SEEN_THROUGH]] = True
+            occupied[open_] += code == OCCUPIED
+        return [self.EMPTY if e else self.OCCUPIED_ONLY if o * self.keyframe_s >= min_occupied_s else self.UNKNOWN
+                for e, o in zip(empty, occupied)]
+
+    def _positions(self) -> np.ndarray:
+        """The keyframes' sensor positions (world frame, m), shape (n, 2), kept until the next keyframe."""
+        if self._xy is None or len(self._xy) != len(self._frames):
+            self._xy = np.array([(pose.x, pose.y) for _, pose in self._frames], dtype=float).reshape(-1, 2)
+        return self._xy
 
     def reset(self) -> None:
         self._frames.clear()
+        self._xy = None

@@ -195,6 +195,7 @@ class StandingConfig:
     confirm_share: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=1.0))
     confirm_radius_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     furniture_radius_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
+    arrivals: bool = field(metadata=_spec())
 
     def params(self):
         from people_tracker.tracker.standing import StandingParams

@@ -145,6 +145,8 @@ class PeopleTracker:
         self.selector = (TargetSelector(follow, same_person_m=self.track_params.min_person_separation_m)
                          if follow is not None else None)
         self.standing = StandingInitiator(standing or StandingParams())
+        self._arrivals = StandingInitiator(self.standing.params)  # single segments (standing.arrivals)
+        self._judged = np.zeros((0, 4))  # ... places never seen empty: x, y and the laser's x, y (world frame, m)
         self.leg_model = leg_model if leg_model is not None else load_leg_model()
         self.existence = existence or ExistenceParams()
         self.places = PlaceMemory(self.existence.place_keyframe_s, self.existence.place_memory_s)
@@ -169,6 +171,8 @@ class PeopleTracker:
         self.detector.reset()
         self.aligner.reset()
         self.standing.reset()
+        self._arrivals.reset()
+        self._judged = np.zeros((0, 4))
         self.places.reset()
         if self.selector is not None:
             self.selector.forget_path()  # the world frame may start anew: no velocity across the jump
@@ -211,6 +215,7 @@ class PeopleTracker:
         self._explained = self._object_readings(detection, {i for _, ci in matched for i in candidates[ci].object_ids})
         self._unmatchable_legs(scan, legs, leg_scores)  # 6. leg-shaped readings
         standing = self._standing_candidates(scan, legs, leg_scores, world)  # 6b. standing people: leg pairs
+        arrivals = self._arrival_candidates(scan, legs, leg_scores, world)  # ... and single segments
         matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
         self._support(scan, world, matched_t)  # 7. static support for the rest
         self._weigh(scan, world)  # 7b. evidence of existence
@@ -219,6 +224,7 @@ class PeopleTracker:
         self._reacquire_standing(scan, world)
         self._initiate(candidates, {ci for _, ci in matched}, scan.stamp)  # 8. new tentative tracks
         self._initiate_standing(standing, scan.stamp)  # 8b. and standing people who persist
+        self._initiate_arrivals(arrivals, world, scan.stamp)  # 8c. and who arrived, legs merged or hidden
         self._delete(scan.stamp)  # 9. delete what the lifecycle rules end
         target = self._follow(world, scan.stamp)  # 10. the followed person
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.reported]
@@ -580,12 +586,14 @@ class PeopleTracker:
                               self.pairing.max_leg_radius_m, self._explained if explained is None else explained,
                               needed)
 
-    def _clear_of_tracks(self, xy: np.ndarray) -> np.ndarray:
-        """Whether each place (world frame) is at least ``spawn_exclusion_m`` from every track."""
+    def _clear_of_tracks(self, xy: np.ndarray, radius_m: float | None = None) -> np.ndarray:
+        """Whether each place (world frame) is at least ``radius_m`` (default
+        ``spawn_exclusion_m``) from every track."""
         known = np.array([t.position for t in self._tracks]).reshape(-1, 2)
         if not len(known) or not len(xy):
             return np.ones(len(xy), dtype=bool)
-        return pairwise_distances(xy, known).min(axis=1) >= self.assoc.spawn_exclusion_m
+        return pairwise_distances(xy, known).min(axis=1) >= (self.assoc.spawn_exclusion_m if radius_m is None
+                                                              else radius_m)
 
     def _support(self, scan: Scan, world: Pose2D, matched: set[int]) -> None:
         idle = [i for i, t in enumerate(self._tracks) if t.confirmed and i not in matched]
@@ -606,19 +614,28 @@ class PeopleTracker:
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
                 t.update(z, R, moving=False)
 
+    def _still_legs(self, scan: Scan, legs: LegCandidates, scores: np.ndarray,
+                    min_score: float) -> tuple[np.ndarray, np.ndarray]:
+        """The leg candidates scoring at least ``min_score`` that no passer-by explains:
+        their centres (sensor frame, m) and widths (m, first to last reading)."""
+        keep = scores >= min_score
+        if self._explained is not None and keep.any():  # a passer-by's leg pairs with nobody standing
+            keep &= ~legs.touching(self._explained)
+        xy = legs.xy[keep]
+        if not len(xy):
+            return xy, np.zeros(0)
+        pts = scan.valid_points
+        widths = np.hypot(*(pts[legs.stop[keep] - 1] - pts[legs.start[keep]]).T)
+        if self.pairing.max_leg_radius_m > 0:
+            xy = leg_centres(xy, widths, self.pairing.max_leg_radius_m)
+        return xy, widths
+
     def _standing_candidates(self, scan: Scan, legs: LegCandidates, scores: np.ndarray,
                              world: Pose2D) -> list[PersonCandidate]:
         p = self.standing.params
         if not p.enabled:
             return []
-        keep = scores >= p.min_leg_probability
-        if self._explained is not None and keep.any():  # a passer-by's leg pairs with nobody standing
-            keep &= ~legs.touching(self._explained)
-        xy = legs.xy[keep]
-        if self.pairing.max_leg_radius_m > 0 and len(xy):
-            pts = scan.valid_points
-            widths = np.hypot(*(pts[legs.stop[keep] - 1] - pts[legs.start[keep]]).T)
-            xy = leg_centres(xy, widths, self.pairing.max_leg_radius_m)
+        xy, _ = self._still_legs(scan, legs, scores, p.min_leg_probability)
         mids, pair_legs_xy = standing_pairs(xy, p)
         if not len(mids):
             return []
@@ -626,6 +643,18 @@ class PeopleTracker:
         legs_w = world.transform_points(pair_legs_xy.reshape(-1, 2)).reshape(-1, 2, 2)
         return [PersonCandidate(float(x), float(y), self.pairing.sigma_pair_m, "standing",
                                 legs=tuple(map(tuple, lw.tolist()))) for (x, y), lw in zip(xy, legs_w)]
+
+    def _arrival_candidates(self, scan: Scan, legs: LegCandidates, scores: np.ndarray,
+                            world: Pose2D) -> np.ndarray:
+        """Single segments that may be someone who arrived and stands (world frame, m):
+        at least as leg-like as the leg model's base rate, no wider than the widest stance
+        plus a leg (two legs merged into one segment), explained by no passer-by."""
+        p = self.standing.params
+        if not (p.enabled and p.arrivals):
+            return np.zeros((0, 2))
+        xy, widths = self._still_legs(scan, legs, scores, self.leg_model.base_rate)
+        xy = xy[widths <= p.max_leg_separation_m + 2.0 * self.pairing.max_leg_radius_m]
+        return world.transform_points(xy) if len(xy) else np.zeros((0, 2))
 
     def _update_standing(self, standing: list[PersonCandidate]) -> set[int]:
         """Standing pairs update confirmed tracks no moving candidate reached; their indices."""
@@ -663,6 +692,44 @@ class PeopleTracker:
         xy = np.array([(c.x, c.y) for c in standing]).reshape(-1, 2)
         persistent = self.standing.persistent(xy, stamp)
         self._spawn([standing[k] for k in np.flatnonzero(persistent)], stamp, standing=True)
+
+    def _initiate_arrivals(self, xy: np.ndarray, world: Pose2D, stamp: float) -> None:
+        """A standing track for each single segment (world frame, m) that persisted as a
+        pair must, away from tracks and furniture, where the place memory saw the floor
+        empty before from about where the laser is now (within ``existence.place_radius_m``:
+        the same view, so no drift of the world frame between the two scans, nor a wall
+        seen edge-on from afar, passes for an arrival): someone walked in and stands there,
+        legs merged or one hidden. It must lie farther from every track than a new track's
+        exclusion plus half the widest stance (it may be a tracked person's leg). Places
+        found never seen empty from here are remembered
+        and not looked up again from here."""
+        if not len(xy):
+            return
+        xy = xy[self._arrivals.persistent(xy, stamp)]
+        # one segment may be one leg of someone tracked, half the widest stance from their torso
+        clear_m = self.assoc.spawn_exclusion_m + 0.5 * self.standing.params.max_leg_separation_m
+        xy = xy[self._clear_of_tracks(xy, clear_m)]
+        view = np.array([world.x, world.y])
+        e = self.existence
+        if len(xy) and len(self._judged):  # judged before, from about here
+            judged = self._judged
+            near = np.hypot(*(judged[:, 2:] - view).T) <= e.place_radius_m
+            if near.any():
+                d = pairwise_distances(xy, judged[near, :2]).min(axis=1)
+                xy = xy[d > self.standing.params.confirm_radius_m]
+        if not len(xy):
+            return
+        places = self.places.histories(xy, stamp - e.place_before_s, e.place_radius_m,
+                                       self.detector.params.no_return_free_m, viewpoint=view,
+                                       viewpoint_radius_m=e.place_radius_m)
+        arrived = [k for k, place in enumerate(places) if place == PlaceMemory.EMPTY]
+        never = np.array([place != PlaceMemory.EMPTY for place in places])
+        if never.any():
+            rows = np.hstack([xy[never], np.broadcast_to(view, (int(never.sum()), 2))])
+            self._judged = np.vstack([self._judged, rows])[-1000:]
+        sigma = self.pairing.sigma_single_leg_m
+        self._spawn([PersonCandidate(float(xy[k, 0]), float(xy[k, 1]), sigma, "standing", legs=(tuple(xy[k]),))
+                     for k in arrived], stamp, standing=True)
 
     def _seen_empty(self, xy: np.ndarray, stamp: float) -> np.ndarray:
         """Whether a scan about ½, 1 or 1½ free-space lookbacks ago saw past each place."""
@@ -757,7 +824,7 @@ class PeopleTracker:
     def _hand_over(self, t: TrackState, living: list[TrackState], stamp: float) -> bool:
         """A person who stood still and set off: their place empties (the standing track
         dies) while a new track starts beside it, which takes the standing one's id."""
-        if not (t.confirmed and t.moved and t.still):
+        if not (t.confirmed and t.existence.walked_or_arrived and t.still):
             return False
         young = [u for u in self._born_beside(t, living, stamp) if u.track_id > t.track_id]
         if not young:
@@ -771,7 +838,7 @@ class PeopleTracker:
         confirmed (walked off; the trailing leg stays on the spot for the first step, so an
         update or two after its birth is no sign that they stayed). Walking away along the
         line of sight hides the place they left, so its emptiness may never be seen."""
-        if not (t.confirmed and t.moved and t.still) or t.updated_now:
+        if not (t.confirmed and t.existence.walked_or_arrived and t.still) or t.updated_now:
             return False
         return any(u.confirmed and not u.still and u.confirmed_at >= t.last_update
                    for u in self._born_beside(t, self._tracks, stamp))
@@ -783,6 +850,7 @@ class PeopleTracker:
         for t in dying:
             if t.furniture() and t.existence.probability >= self.existence.delete:
                 self.standing.furniture(t.position)
+                self._arrivals.furniture(t.position)
             self._hand_over(t, keep, stamp)
         self._tracks = keep
 

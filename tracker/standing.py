@@ -44,6 +44,11 @@ class StandingParams:
         How far apart (world frame) the pairs of those scans may be, metres.
     furniture_radius_m : float
         No standing track starts this close to where one ended unmoved, metres.
+    arrivals : bool
+        Also start a standing track from one segment at least as leg-like as the leg model's
+        base rate that persists
+        (as a pair must) where the place memory saw the floor empty before: someone arrived
+        and stands with their legs merged into one segment, or one leg hidden.
     """
 
     enabled: bool = True
@@ -54,6 +59,7 @@ class StandingParams:
     confirm_share: float = 0.6
     confirm_radius_m: float = 0.2
     furniture_radius_m: float = 0.5
+    arrivals: bool = True
 
 
 def standing_pairs(legs_xy: np.ndarray, params: StandingParams) -> tuple[np.ndarray, np.ndarray]:

@@ -327,6 +327,70 @@ def test_a_pair_of_leg_like_posts_is_never_reported_and_is_remembered_as_furnitu
     assert len(trk.standing._furniture) == 1
 
 
+def _room_scan(stamp, blocked_deg=None, at_m=3.0):
+    """A 270° scan (0.5°) of a wall 5 m away all round; with ``blocked_deg`` (lo, hi), a
+    person-sized thing ``at_m`` away across those bearings."""
+    angles = np.radians(np.arange(-135.0, 135.0 + 1e-9, 0.5))
+    ranges = np.full(len(angles), 5.0)
+    if blocked_deg is not None:
+        ranges[(angles >= np.radians(blocked_deg[0])) & (angles <= np.radians(blocked_deg[1]))] = at_m
+    return Scan(ranges, float(angles[0]), float(np.radians(0.5)), 0.05, 30.0, stamp)
+
+
+def _arrivals_over(tracker, place, pose_of, stamps, blocked_from):
+    """Keyframes of the room (empty before ``blocked_from`` s, something at ``place`` after),
+    and the single segment offered to the arrival rule from then on, at each stamp."""
+    for stamp in stamps:
+        pose = pose_of(stamp)
+        here = pose.inverse().transform_points(place[None])[0]
+        bearing = np.degrees(np.arctan2(here[1], here[0]))
+        there = stamp >= blocked_from
+        tracker.places.add(_room_scan(stamp, (bearing - 2.0, bearing + 2.0) if there else None,
+                                      float(np.hypot(*here))), pose)
+        if there:
+            tracker._initiate_arrivals(place[None], pose, stamp)
+
+
+def test_one_segment_where_the_floor_was_seen_empty_from_here_starts_a_standing_track():
+    """Traced in the waiting room (seed 32): someone who walked in hidden behind a person
+    standing, and stood in plain view once that person left, had their two legs seen as one
+    segment the leg model scores below a standing leg: no pair ever started a track, though
+    the laser had seen the floor there empty before they came. One segment that persists
+    where the floor was seen empty, from where the laser is now, starts a standing track
+    that has arrived; one where the floor was never seen empty does not, and its place is
+    not looked up again."""
+    from people_tracker.models.pose import Pose2D
+    place = np.array([3.0, 0.0])
+    stamps = np.arange(0.0, 8.0, 0.1)
+    tracker = PeopleTracker.from_config(load_config())
+    _arrivals_over(tracker, place, lambda s: Pose2D(), stamps, blocked_from=5.0)
+    assert len(tracker._tracks) == 1
+    t = tracker._tracks[0]
+    assert t.born_standing and t.existence.walked_or_arrived
+    assert np.hypot(*(t.position - place)) < 1e-9
+    assert t.existence.probability > tracker.existence.prior_standing  # the arrival's evidence
+
+    always = PeopleTracker.from_config(load_config())  # there from the first scan: furniture
+    _arrivals_over(always, place, lambda s: Pose2D(), stamps, blocked_from=0.0)
+    assert always._tracks == [] and len(always._judged) == 1  # judged once, from here
+
+
+def test_seen_empty_only_from_far_away_is_no_arrival():
+    """The same segment, but the floor was seen empty only from where the laser no longer
+    is (a robot that drove on: its world frame may have drifted, and a wall seen edge-on
+    from afar may have looked seen through): no track."""
+    from people_tracker.models.pose import Pose2D
+    place = np.array([3.0, 0.0])
+    tracker = PeopleTracker.from_config(load_config())
+    # the laser 1 m back (x = -1) while the floor there was empty, at x = 0 from then on
+    _arrivals_over(tracker, place, lambda s: Pose2D(-1.0 if s < 5.0 else 0.0, 0.0, 0.0),
+                   np.arange(0.0, 8.0, 0.1), blocked_from=5.0)
+    assert tracker._tracks == []
+    memory = tracker.places
+    assert memory.histories(place[None], 4.0, 0.25)[0] == memory.EMPTY  # seen from 1 m back ...
+    assert memory.histories(place[None], 4.0, 0.25, viewpoint=(0.0, 0.0), viewpoint_radius_m=0.25)[0] != memory.EMPTY
+
+
 def test_a_person_held_still_is_not_pulled_away_by_a_distant_moving_candidate():
     t, _ = new_track(standing=True)
     t.confirmed = True
