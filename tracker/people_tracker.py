@@ -304,24 +304,30 @@ class PeopleTracker:
             t.hidden_position = None  # once per spell out of sight
 
     def _remember_standing(self, scan: Scan, world: Pose2D) -> None:
-        """Remember where reported people who walked in stand still (world frame), with their
-        id and evidence, until the place is seen empty or ``place_memory_s`` has passed."""
+        """Remember where reported people who walked in (or arrived) stand still (world frame),
+        with their id and evidence, until the place is seen empty or ``place_memory_s`` has
+        passed."""
         stamp = scan.stamp
         stood = self._stood
         if stood:
             xy = np.array([e.xy for e in stood])
             vis = place_visibility(xy, scan, world, self.existence.place_radius_m, self.detector.params.no_return_free_m)
             stood = [e for e, v in zip(stood, vis) if v != SEEN_THROUGH and e.stamp >= stamp - self.existence.place_memory_s]
+        alive = {t.track_id for t in self._tracks}
         for t in self._tracks:
-            if t.reported and t.moved and t.still and t.place != PlaceMemory.OCCUPIED_ONLY:
-                for e in stood:
-                    if e.track_id == t.track_id or np.hypot(*(e.xy - t.position)) <= self.assoc.support_anchor_m:
-                        # keep when they first came: a track taken up here again (below) began
-                        # standing, so its last move is that re-take, not their arrival
-                        e.xy, e.stamp, e.track_id, e.l_dyn, e.guess = (t.position.copy(), stamp, t.track_id,
-                                                                       t.existence.l_dyn, False)
-                        e.came = min(e.came, t.last_moving_update)
-                        break
+            if t.reported and t.existence.walked_or_arrived and t.still and t.place != PlaceMemory.OCCUPIED_ONLY:
+                # their own place, else one near them whose track is gone (a track taken up
+                # here again, below, has a new id); never the place of someone still tracked,
+                # however close they stand (face to face, one hidden, the other's track slides)
+                e = next((e for e in stood if e.track_id == t.track_id), None) or \
+                    next((e for e in stood if e.track_id not in alive and
+                          np.hypot(*(e.xy - t.position)) <= self.assoc.support_anchor_m), None)
+                if e is not None:
+                    # keep when they first came: a track taken up here again (below) began
+                    # standing, so its last move is that re-take, not their arrival
+                    e.xy, e.stamp, e.track_id, e.l_dyn, e.guess = (t.position.copy(), stamp, t.track_id,
+                                                                   t.existence.l_dyn, False)
+                    e.came = min(e.came, t.last_moving_update)
                 else:
                     stood.append(StoodPlace(t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False,
                                              t.last_moving_update))

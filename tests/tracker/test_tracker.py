@@ -457,6 +457,40 @@ def test_a_walker_who_walks_on_in_the_open_is_not_remembered():
     assert not tracker._stood
 
 
+def test_where_someone_hidden_stood_is_not_taken_over_by_their_neighbours_track():
+    """Traced in the waiting room (seed 21): two people stood face to face 0.58 m apart;
+    one was hidden and their track ended, and the neighbour's track, sliding 0.1 m towards
+    them, took over the memory of where they stood (it lay within support_anchor_m), so
+    when they came back into view minutes later nothing knew them. A track updates its own
+    place; it takes over another only when that one's track is gone and it has none."""
+    from people_tracker.models.pose import Pose2D
+
+    tracker = PeopleTracker.from_config(load_config())
+    scan = _room_scan(10.0, (-10.0, 20.0), 1.0)  # someone 1 m ahead hides them both
+    a, _ = new_track(x=3.0, y=0.0, standing=True)
+    b, _ = new_track(x=3.0, y=0.58, standing=True)
+    b.track_id = 2
+    for t in (a, b):
+        t.confirmed = True
+        t.place = "unknown"
+        assert t.reported and t.still and t.existence.walked_or_arrived
+    tracker._tracks = [a, b]
+    tracker._remember_standing(scan, Pose2D())
+    assert sorted(e.track_id for e in tracker._stood) == [1, 2]
+    tracker._tracks = [b]  # a's person is hidden and their track ends
+    b.kf.x[0], b.kf.x[2] = 3.0, 0.45  # b slides towards where a stood: 0.45 m from it
+    tracker._remember_standing(scan, Pose2D())
+    mine = {e.track_id: e.xy for e in tracker._stood}
+    assert sorted(mine) == [1, 2]
+    assert mine[1] == pytest.approx([3.0, 0.0])  # still where a stood, under a's id
+    assert mine[2] == pytest.approx([3.0, 0.45])
+    c, _ = new_track(x=3.0, y=0.2, standing=True)  # a's person taken up again under a new id
+    c.track_id, c.confirmed, c.place = 3, True, "unknown"
+    tracker._tracks = [b, c]
+    tracker._remember_standing(scan, Pose2D())
+    assert sorted(e.track_id for e in tracker._stood) == [2, 3]  # a's place goes to c
+
+
 def test_of_two_people_standing_too_close_the_track_that_slid_there_goes():
     """Traced in the waiting room (seed 21): two people stood face to face 0.6 m apart; when
     one of them was hidden, their track slid over onto the other, and the rule "two standing
