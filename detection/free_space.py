@@ -194,7 +194,7 @@ class PlaceMemory:
 
     def _positions(self) -> np.ndarray:
         """The keyframes' sensor positions (world frame, m), shape (n, 2), kept until the next keyframe."""
-        if self._xy is None or len(self._xy) != len(self._frames):
+        if self._xy is None:
             self._xy = np.array([(pose.x, pose.y) for _, pose in self._frames], dtype=float).reshape(-1, 2)
         return self._xy
 

@@ -80,11 +80,19 @@ class LegCandidates:
     def __len__(self) -> int:
         return len(self.xy)
 
+    @property
+    def width_m(self) -> np.ndarray:
+        """Each candidate's width: first to last reading, metres, shape (k,) (its feature)."""
+        return self.features[:, _WIDTH]
+
     def touching(self, mask: np.ndarray) -> np.ndarray:
         """Which candidates span a beam where ``mask`` (bool, one per beam of the scan) is set."""
         # c[i] counts the set beams before beam i
         c = np.concatenate([[0], np.cumsum(mask)])
         return c[self.last_beam + 1] > c[self.first_beam]
+
+
+_WIDTH = FEATURES.index("width_m")
 
 
 def _empty() -> LegCandidates:

@@ -145,7 +145,7 @@ class PeopleTracker:
         self.selector = (TargetSelector(follow, same_person_m=self.track_params.min_person_separation_m)
                          if follow is not None else None)
         self.standing = StandingInitiator(standing or StandingParams())
-        self._arrivals = StandingInitiator(self.standing.params)  # single segments (standing.arrivals)
+        self._arrivals = self.standing.twin()  # single segments (standing.arrivals), the same furniture
         self._judged = np.zeros((0, 4))  # ... places never seen empty: x, y and the laser's x, y (world frame, m)
         self.leg_model = leg_model if leg_model is not None else load_leg_model()
         self.existence = existence or ExistenceParams()
@@ -214,8 +214,9 @@ class PeopleTracker:
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
         self._explained = self._object_readings(detection, {i for _, ci in matched for i in candidates[ci].object_ids})
         self._unmatchable_legs(scan, legs, leg_scores)  # 6. leg-shaped readings
-        standing = self._standing_candidates(scan, legs, leg_scores, world)  # 6b. standing people: leg pairs
-        arrivals = self._arrival_candidates(scan, legs, leg_scores, world)  # ... and single segments
+        still = self._still_legs(legs) if self.standing.params.enabled else None
+        standing = self._standing_candidates(still, leg_scores, world)  # 6b. standing people: leg pairs
+        arrivals = self._arrival_candidates(still, leg_scores, world)  # ... and single segments
         matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
         self._support(scan, world, matched_t)  # 7. static support for the rest
         self._weigh(scan, world)  # 7b. evidence of existence
@@ -620,29 +621,24 @@ class PeopleTracker:
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
                 t.update(z, R, moving=False)
 
-    def _still_legs(self, scan: Scan, legs: LegCandidates, scores: np.ndarray,
-                    min_score: float) -> tuple[np.ndarray, np.ndarray]:
-        """The leg candidates scoring at least ``min_score`` that no passer-by explains:
-        their centres (sensor frame, m) and widths (m, first to last reading)."""
-        keep = scores >= min_score
-        if self._explained is not None and keep.any():  # a passer-by's leg pairs with nobody standing
-            keep &= ~legs.touching(self._explained)
-        xy = legs.xy[keep]
-        if not len(xy):
-            return xy, np.zeros(0)
-        pts = scan.valid_points
-        widths = np.hypot(*(pts[legs.stop[keep] - 1] - pts[legs.start[keep]]).T)
-        if self.pairing.max_leg_radius_m > 0:
-            xy = leg_centres(xy, widths, self.pairing.max_leg_radius_m)
-        return xy, widths
+    def _still_legs(self, legs: LegCandidates) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every leg candidate's centre (sensor frame, m) and width (m, first to last
+        reading), and whether no passer-by explains it (a passer-by's leg pairs with nobody
+        standing)."""
+        widths = legs.width_m
+        xy = leg_centres(legs.xy, widths, self.pairing.max_leg_radius_m) if self.pairing.max_leg_radius_m > 0 \
+            else legs.xy
+        free = ~legs.touching(self._explained) if self._explained is not None else np.ones(len(legs), dtype=bool)
+        return xy, widths, free
 
-    def _standing_candidates(self, scan: Scan, legs: LegCandidates, scores: np.ndarray,
-                             world: Pose2D) -> list[PersonCandidate]:
+    def _standing_candidates(self, still: tuple, scores: np.ndarray, world: Pose2D) -> list[PersonCandidate]:
+        """Leg pairs a stance apart (world frame) among ``still`` (:meth:`_still_legs`) legs
+        the leg model finds at least ``standing.min_leg_probability`` likely."""
         p = self.standing.params
         if not p.enabled:
             return []
-        xy, _ = self._still_legs(scan, legs, scores, p.min_leg_probability)
-        mids, pair_legs_xy = standing_pairs(xy, p)
+        xy, _, free = still
+        mids, pair_legs_xy = standing_pairs(xy[free & (scores >= p.min_leg_probability)], p)
         if not len(mids):
             return []
         xy = world.transform_points(mids)
@@ -650,16 +646,16 @@ class PeopleTracker:
         return [PersonCandidate(float(x), float(y), self.pairing.sigma_pair_m, "standing",
                                 legs=tuple(map(tuple, lw.tolist()))) for (x, y), lw in zip(xy, legs_w)]
 
-    def _arrival_candidates(self, scan: Scan, legs: LegCandidates, scores: np.ndarray,
-                            world: Pose2D) -> np.ndarray:
-        """Single segments that may be someone who arrived and stands (world frame, m):
-        at least as leg-like as the leg model's base rate, no wider than the widest stance
-        plus a leg (two legs merged into one segment), explained by no passer-by."""
+    def _arrival_candidates(self, still: tuple, scores: np.ndarray, world: Pose2D) -> np.ndarray:
+        """Single segments that may be someone who arrived and stands (world frame, m), among
+        ``still`` (:meth:`_still_legs`) legs: at least as leg-like as the leg model's base
+        rate, no wider than the widest stance plus a leg (two legs merged into one segment)."""
         p = self.standing.params
         if not (p.enabled and p.arrivals):
             return np.zeros((0, 2))
-        xy, widths = self._still_legs(scan, legs, scores, self.leg_model.base_rate)
-        xy = xy[widths <= p.max_leg_separation_m + 2.0 * self.pairing.max_leg_radius_m]
+        xy, widths, free = still
+        xy = xy[free & (scores >= self.leg_model.base_rate) &
+                (widths <= p.max_leg_separation_m + 2.0 * self.pairing.max_leg_radius_m)]
         return world.transform_points(xy) if len(xy) else np.zeros((0, 2))
 
     def _update_standing(self, standing: list[PersonCandidate]) -> set[int]:
@@ -707,8 +703,7 @@ class PeopleTracker:
         seen edge-on from afar, passes for an arrival): someone walked in and stands there,
         legs merged or one hidden. It must lie farther from every track than a new track's
         exclusion plus half the widest stance (it may be a tracked person's leg). Places
-        found never seen empty from here are remembered
-        and not looked up again from here."""
+        found never seen empty from here are remembered and not looked up again from here."""
         if not len(xy):
             return
         xy = xy[self._arrivals.persistent(xy, stamp)]
@@ -718,21 +713,20 @@ class PeopleTracker:
         view = np.array([world.x, world.y])
         e = self.existence
         if len(xy) and len(self._judged):  # judged before, from about here
-            judged = self._judged
-            near = np.hypot(*(judged[:, 2:] - view).T) <= e.place_radius_m
+            near = np.hypot(*(self._judged[:, 2:] - view).T) <= e.place_radius_m
             if near.any():
-                d = pairwise_distances(xy, judged[near, :2]).min(axis=1)
+                d = pairwise_distances(xy, self._judged[near, :2]).min(axis=1)
                 xy = xy[d > self.standing.params.confirm_radius_m]
         if not len(xy):
             return
         places = self.places.histories(xy, stamp - e.place_before_s, e.place_radius_m,
                                        self.detector.params.no_return_free_m, viewpoint=view,
                                        viewpoint_radius_m=e.place_radius_m)
-        arrived = [k for k, place in enumerate(places) if place == PlaceMemory.EMPTY]
-        never = np.array([place != PlaceMemory.EMPTY for place in places])
-        if never.any():
-            rows = np.hstack([xy[never], np.broadcast_to(view, (int(never.sum()), 2))])
+        empty = np.array([place == PlaceMemory.EMPTY for place in places])
+        if not empty.all():
+            rows = np.hstack([xy[~empty], np.broadcast_to(view, (int((~empty).sum()), 2))])
             self._judged = np.vstack([self._judged, rows])[-1000:]
+        arrived = np.flatnonzero(empty)
         sigma = self.pairing.sigma_single_leg_m
         self._spawn([PersonCandidate(float(xy[k, 0]), float(xy[k, 1]), sigma, "standing", legs=(tuple(xy[k]),))
                      for k in arrived], stamp, standing=True)
@@ -856,7 +850,6 @@ class PeopleTracker:
         for t in dying:
             if t.furniture() and t.existence.probability >= self.existence.delete:
                 self.standing.furniture(t.position)
-                self._arrivals.furniture(t.position)
             self._hand_over(t, keep, stamp)
         self._tracks = keep
 

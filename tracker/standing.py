@@ -46,9 +46,9 @@ class StandingParams:
         No standing track starts this close to where one ended unmoved, metres.
     arrivals : bool
         Also start a standing track from one segment at least as leg-like as the leg model's
-        base rate that persists
-        (as a pair must) where the place memory saw the floor empty before: someone arrived
-        and stands with their legs merged into one segment, or one leg hidden.
+        base rate that persists (as a pair must) where the place memory saw the floor empty
+        before, from about where the laser is now: someone arrived and stands with their legs
+        merged into one segment, or one leg hidden.
     """
 
     enabled: bool = True
@@ -107,6 +107,13 @@ class StandingInitiator:
             d = pairwise_distances(pairs_world, f)
             ok &= d.min(axis=1) > p.furniture_radius_m
         return ok
+
+    def twin(self) -> "StandingInitiator":
+        """Another initiator with the same parameters and the same furniture memory (a place
+        told to either is remembered once, for both), and its own recent history."""
+        other = StandingInitiator(self.params, self._furniture.maxlen)
+        other._furniture = self._furniture
+        return other
 
     def furniture(self, xy_world: np.ndarray) -> None:
         """Remember a place (world frame, m) where a standing 'person' never moved."""
