@@ -93,6 +93,7 @@ class PairingConfig:
     flat_min_length_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
     flat_max_depth_m: float = field(metadata=_spec(lo=0.0, hi=1.0))
     stance_partner: bool = field(metadata=_spec())
+    max_leg_spread_m: float = field(metadata=_spec(lo=0.0, hi=5.0))
 
     def params(self):
         from people_tracker.tracker.pairing import PairingParams

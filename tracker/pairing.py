@@ -49,6 +49,12 @@ class PairingParams:
     stance_partner : bool
         Pair a walking person's lone moving leg with their standing leg, a still
         leg-shaped segment beside it (see ``PeopleTracker._stance_partners``).
+    max_leg_spread_m : float
+        Farthest a walking person's two legs lie apart across their heading: hip width and
+        step width, with room for a turn the velocity has not caught up with yet. A pair
+        with a leg a walker owns that is wider across their heading is their leg and
+        somebody else's, for example the first step of someone setting off beside them
+        (see :func:`pair_legs`). 0 turns it off.
     """
 
     min_leg_size_m: float = 0.04
@@ -62,6 +68,7 @@ class PairingParams:
     flat_min_length_m: float = 0.16
     flat_max_depth_m: float = 0.015
     stance_partner: bool = True
+    max_leg_spread_m: float = 0.5
 
     @property
     def half_stride_m(self) -> float:
@@ -181,9 +188,19 @@ def _stays_with_owner(xy: np.ndarray, g: np.ndarray, predictions: np.ndarray, ha
     return ~mixed | (d_mid <= half_stride_m) | (d_mid < d_own)
 
 
+def _across_heading(xy: np.ndarray, g: np.ndarray, headings: np.ndarray, spread_m: float) -> np.ndarray:
+    """(k, k) mask: False where a leg a walker owns (``g`` >= 0, with a heading) and another
+    leg lie farther than ``spread_m`` apart across that walker's heading."""
+    h = headings[np.maximum(g, 0)] * (g >= 0)[:, None]  # (k, 2): the owner's heading, or 0
+    dx = xy[None, :, 0] - xy[:, None, 0]
+    dy = xy[None, :, 1] - xy[:, None, 1]
+    across = np.abs(h[:, 0, None] * dy - h[:, 1, None] * dx)  # row leg's owner's heading
+    return (across <= spread_m) & (across.T <= spread_m)
+
+
 def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: PairingParams,
               groups: np.ndarray | None = None, depths: np.ndarray | None = None,
-              predictions: np.ndarray | None = None) -> list[PersonCandidate]:
+              predictions: np.ndarray | None = None, headings: np.ndarray | None = None) -> list[PersonCandidate]:
     """Person candidates from moving objects.
 
     Parameters
@@ -207,6 +224,10 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
         nearer it than their own leg does. A pair that pulls their leg away from them is
         their leg and somebody else's (a passer-by's leg with the one of a person they
         half hide), a torso where nobody is.
+    headings : ndarray, shape (p, 2), optional
+        The owners' walking directions (unit vectors, same frame; zero where they walk too
+        slowly to tell): a pair with a leg a walker owns lies no wider than
+        ``max_leg_spread_m`` across their heading.
     """
     round_ = np.ones(len(sizes), dtype=bool)
     if depths is not None and params.flat_max_depth_m > 0:
@@ -220,6 +241,8 @@ def pair_legs(xy: np.ndarray, sizes: np.ndarray, ids: list[int], params: Pairing
         allowed = (g[:, None] == g[None, :]) | (g[:, None] < 0) | (g[None, :] < 0)
         if predictions is not None and len(predictions):
             allowed &= _stays_with_owner(xy[legs], g, predictions, params.half_stride_m)
+        if headings is not None and len(headings) and params.max_leg_spread_m > 0:
+            allowed &= _across_heading(xy[legs], g, headings, params.max_leg_spread_m)
     paired = set()
     for a, b in nearest_pairs(xy[legs], 0.0, params.max_leg_separation_m, allowed):
         i, j = int(legs[a]), int(legs[b])

@@ -119,6 +119,7 @@ class StoodPlace:
 PASSING_MPS = 0.3
 SET_OFF_S = 3.0  # s: a track this young that began beside someone standing may be them, set off
 TURN_S = 1.0  # s: a walker whose legs were last seen moving this recently may have turned sharply
+HEADING_MPS = 0.5  # m/s: a track at least this fast has a heading its legs are spread along
 
 
 class PeopleTracker:
@@ -410,7 +411,7 @@ class PeopleTracker:
         predicted = np.array([t.position for t in walking]).reshape(-1, 2)
         groups = owners(xy, predicted, self.pairing.half_stride_m)
         out = pair_legs(xy, np.array([o.length for o in objs]), [o.object_id for o in objs], self.pairing, groups,
-                        np.array([o.width for o in objs]), predicted)
+                        np.array([o.width for o in objs]), predicted, _headings(walking))
         return self._stance_partners(out, detection, world, legs, leg_scores, xy, groups, walking)
 
     def _stance_partners(self, candidates: list[PersonCandidate], detection: Detection, world: Pose2D,
@@ -901,6 +902,19 @@ class PeopleTracker:
         """The track ``t`` goes on under a new id (it is no longer the followed person)."""
         t.track_id, self._next_id = self._next_id, self._next_id + 1
         return None
+
+
+def _headings(tracks: list[TrackState]) -> np.ndarray:
+    """(n, 2) unit vectors along each track's velocity (world frame); zero where it is slower
+    than ``HEADING_MPS``, not known to twice its standard deviation, or estimated for less
+    than ``TURN_S`` since it was last forgotten (someone who just set off or turned sharply
+    spreads their legs across their path)."""
+    v = np.array([t.velocity for t in tracks], dtype=float).reshape(-1, 2)
+    v_std = np.array([math.sqrt(t.kf.P[1, 1] + t.kf.P[3, 3]) for t in tracks], dtype=float)
+    steady = np.array([t.stamp - t.velocity_since >= TURN_S for t in tracks], dtype=bool)
+    speed = np.hypot(v[:, 0], v[:, 1])
+    fast = (speed >= HEADING_MPS) & (speed >= 2.0 * v_std) & steady
+    return np.where(fast[:, None], v / np.where(fast, speed, 1.0)[:, None], 0.0)
 
 
 def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:

@@ -95,6 +95,7 @@ class TrackState:
         self.born = stamp
         self.last_update = stamp
         self.last_moving_update = stamp
+        self.velocity_since = stamp  # when its velocity was last forgotten (born, stood, turned), s
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
         self.seen_position = np.array([x, y])  # where the last update of any kind put it, m
         self.hidden_position: np.ndarray | None = None  # the last predicted place found hidden since the last update, m
@@ -147,6 +148,7 @@ class TrackState:
     def forget_velocity(self) -> None:
         """Reset the velocity's uncertainty to a new track's (after a sharp turn)."""
         v = self.params.init_speed_std_mps ** 2
+        self.velocity_since = self.stamp
         for i in (1, 3):
             self.kf.P[i, :] = 0.0
             self.kf.P[:, i] = 0.0

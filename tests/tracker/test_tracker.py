@@ -597,3 +597,45 @@ def test_a_walkers_leg_never_pairs_away_from_them_with_a_leg_nobody_owns():
     groups = owners(xy, walker, 0.4)
     assert groups.tolist() == [0, -1]
     assert [c.kind for c in pair_legs(xy, sizes, [1, 2], p, groups, predictions=walker)] == ["pair"]
+
+
+def test_a_walkers_leg_never_pairs_with_a_leg_far_across_their_heading():
+    """Traced in the waiting room: someone setting off 0.9 m beside a walker's path; the
+    walker's leg and their first step paired into a torso between them, and the walker's
+    track left with the one setting off."""
+    from people_tracker.tracker.pairing import owners
+    p = PairingParams()  # legs at most 0.5 m apart across a walker's heading
+    walker = np.array([[2.0, 0.0]])
+    sizes = np.full(2, 0.12)
+    east, north, slow = np.array([[1.0, 0.0]]), np.array([[0.0, 1.0]]), np.zeros((1, 2))
+    # their leg 0.1 m beside the prediction, a leg nobody owns 0.6 m beyond it: the midpoint
+    # lies within half a stride, so only the heading tells
+    xy = np.array([[2.0, 0.1], [2.0, 0.7]])
+    groups = owners(xy, walker, 0.4)
+    assert groups.tolist() == [0, -1]
+    kinds = lambda h: sorted(c.kind for c in pair_legs(xy, sizes, [1, 2], p, groups, predictions=walker, headings=h))
+    assert kinds(east) == ["leg", "leg"]  # 0.6 m across a walker heading east: two people
+    assert kinds(north) == ["pair"]  # the same legs along their heading: a stride
+    assert kinds(slow) == ["pair"]  # too slow to have a heading: nothing to tell by
+    off = PairingParams(max_leg_spread_m=0.0)
+    assert [c.kind for c in pair_legs(xy, sizes, [1, 2], off, groups, predictions=walker, headings=east)] == ["pair"]
+
+
+def test_a_heading_is_known_only_for_a_steady_walker():
+    from people_tracker.tracker.people_tracker import _headings
+    walker, R = new_track()
+    for k in range(1, 16):  # walking east at 1 m/s for 1.5 s
+        walker.predict(0.1 * k)
+        walker.update(np.array([0.1 * k, 0.0]), R, moving=True)
+    np.testing.assert_allclose(_headings([walker]), [[1.0, 0.0]], atol=0.05)
+    walker.forget_velocity()  # a sharp turn: its velocity is as unknown as a new track's
+    assert not _headings([walker]).any()
+    for k in range(16, 22):  # walking on for 0.6 s: less than TURN_S since
+        walker.predict(0.1 * k)
+        walker.update(np.array([0.1 * k, 0.0]), R, moving=True)
+    assert not _headings([walker]).any()
+    slow, R = new_track()
+    for k in range(1, 16):  # 0.3 m/s: too slow to say which way the legs spread
+        slow.predict(0.1 * k)
+        slow.update(np.array([0.03 * k, 0.0]), R, moving=True)
+    assert not _headings([slow]).any()
