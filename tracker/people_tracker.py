@@ -436,7 +436,7 @@ class PeopleTracker:
         still = keep & ~legs.touching(self._object_readings(detection))
         if not still.any():
             return candidates
-        widths = legs.features[still, 1]
+        widths = legs.width_m[still]
         s_xy = world.transform_points(leg_centres(legs.xy[still], widths, self.pairing.max_leg_radius_m))
         # a standing person's legs are theirs: the owner among everyone confirmed, walking or not
         everyone = [t for t in self._tracks if t.confirmed]
