@@ -476,7 +476,8 @@ class PeopleTracker:
         person's size (``pairing.max_person_size_m``) of it: a surface seen at a grazing angle
         behind a moving robot is revealed too, step by step, but has no leg's shape. Not where
         the place memory only ever saw the place occupied (furniture). These candidates start
-        no track and re-join no turn (``association.receding``)."""
+        no track, re-join no turn and update nobody standing still (``association.receding``):
+        someone standing is not revealed behind themselves."""
         if not self.assoc.receding:
             return []
         walkers = [t for t in self._tracks if t.confirmed and t.moved and not t.still]
@@ -521,6 +522,9 @@ class PeopleTracker:
             far = np.where(moved[:, None], d_here > self.track_params.min_person_separation_m,
                            d_found > self.assoc.recover_radius_m)
             cost[still[:, None] & far] = np.inf
+            # a walker's revealed readings are theirs: someone standing is not revealed behind themselves
+            receding = np.array([c.kind == "receding" for c in candidates])
+            cost[still[:, None] & receding[None, :]] = np.inf
         # one assignment for every track; a tentative track pays -2 ln P(it exists) on top of
         # the squared Mahalanobis distance (a pairing's negative log-likelihood), so a new
         # track on someone's second leg gives way to their confirmed track, while a passer-by's
@@ -608,6 +612,7 @@ class PeopleTracker:
         if not idle:
             return
         found = self._static_support(np.array([self._tracks[i].position for i in idle]), scan, world)
+        self._support_without_walkers_legs(idle, found, scan, world)
         # someone who stops stands where their legs were last seen moving, while the
         # prediction walks on: look there too
         again = [k for k, z in enumerate(found) if z is None and
@@ -621,6 +626,41 @@ class PeopleTracker:
             t = self._tracks[i]
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
                 t.update(z, R, moving=False)
+
+    def _nearer_a_walker(self, idx: list[int], xy: np.ndarray) -> np.ndarray:
+        """Whether each place of ``xy`` (world frame, m) lies nearer another confirmed track
+        that took a moving candidate this scan than the track ``idx[a]``: shape
+        (len(idx), len(xy)). A walker's standing leg beside someone is the walker's."""
+        walkers = [i for i, t in enumerate(self._tracks) if t.confirmed and t.update_kind == "moving"]
+        out = np.zeros((len(idx), len(xy)), dtype=bool)
+        if not walkers or not len(xy):
+            return out
+        d = pairwise_distances(np.array([self._tracks[i].position for i in walkers]), xy)  # (walkers, places)
+        mine = pairwise_distances(np.array([self._tracks[i].position for i in idx]), xy)
+        for a, i in enumerate(idx):
+            others = d[[w != i for w in walkers]]
+            if len(others):
+                out[a] = others.min(axis=0) < mine[a]
+        return out
+
+    def _support_without_walkers_legs(self, idle: list[int], found: list, scan: Scan, world: Pose2D) -> None:
+        """Static support found for ``idle`` tracks, again without the readings that lie
+        nearer a walker (:meth:`_nearer_a_walker`), for each supported track standing still
+        with such a walker within two support radii: a visitor's standing leg beside someone
+        standing is the visitor's. Not for a walker's track (in stance phase or hidden, its
+        prediction may lag behind their legs, nearer someone passing them)."""
+        reach = 2.0 * self.assoc.support_radius_m
+        walkers = np.array([t.position for t in self._tracks
+                            if t.confirmed and t.update_kind == "moving"]).reshape(-1, 2)
+        near = [k for k, i in enumerate(idle) if found[k] is not None and self._tracks[i].still and
+                np.any(np.hypot(*(walkers - self._tracks[i].position).T) <= reach)]
+        if not near:
+            return
+        theirs = self._nearer_a_walker([idle[k] for k in near], world.transform_points(scan.valid_points))
+        for k, mask in zip(near, theirs):
+            explained = np.zeros(scan.n_beams, dtype=bool) if self._explained is None else self._explained.copy()
+            explained[scan.valid_index[mask]] = True
+            found[k] = self._static_support(self._tracks[idle[k]].position[None], scan, world, explained)[0]
 
     def _still_legs(self, legs: LegCandidates) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Every leg candidate's centre (sensor frame, m) and width (m, first to last
@@ -672,6 +712,11 @@ class PeopleTracker:
         anchors = np.array([self._tracks[i].moving_position for i in idle])
         far = pairwise_distances(anchors, z) > self.assoc.support_anchor_m
         cost[far] = np.inf
+        # a pair with a leg nearer a walker is not this one's: it is the walker's standing leg
+        of = np.repeat(np.arange(len(standing)), [len(c.legs) for c in standing])
+        theirs = self._nearer_a_walker(idle, np.array([leg for c in standing for leg in c.legs]).reshape(-1, 2))
+        for b in np.unique(of[theirs.any(axis=0)]):
+            cost[theirs[:, of == b].any(axis=1), b] = np.inf
         out, used = set(), set()
         for a, b in associate(cost, self.assoc.gate_chi2, self.assoc.method):
             self._tracks[idle[a]].update(z[b], standing[b].R, moving=False)

@@ -9,7 +9,7 @@ from people_tracker.models.scan import Scan
 from people_tracker.tracker.config import config_from_dict, load_config
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.io.ground_truth import GroundTruth
-from people_tracker.tracker.pairing import PairingParams, pair_legs
+from people_tracker.tracker.pairing import PairingParams, PersonCandidate, pair_legs
 from people_tracker.tracker.people_tracker import AssociationParams, PeopleTracker, tracks_in_sensor_frame
 from people_tracker.detection.free_space import OCCLUDED, OCCUPIED, SEEN_THROUGH, UNSEEN
 from people_tracker.tracker.existence import Existence, ExistenceParams
@@ -639,3 +639,84 @@ def test_a_heading_is_known_only_for_a_steady_walker():
         slow.predict(0.1 * k)
         slow.update(np.array([0.03 * k, 0.0]), R, moving=True)
     assert not _headings([slow]).any()
+
+
+def test_a_standing_pair_with_a_walkers_leg_is_not_someone_elses():
+    """Traced in the waiting room (seed 52, 58 s): a visitor stopped 0.45 m beside someone
+    standing; a standing pair made of one leg of each (a stance apart) updated the standing
+    person's track for six scans, pulling it 0.15 m towards the visitor, until the two tracks
+    were closer than two people stand and the visitor's was deleted as a duplicate. A leg
+    nearer a walker (a confirmed track that took a moving candidate this scan) than this
+    track is the walker's standing leg."""
+    tracker = PeopleTracker.from_config(load_config())
+    stander, _ = new_track(x=4.38, y=0.06, params=tracker.track_params, standing=True)
+    visitor, _ = new_track(x=4.05, y=0.34, params=tracker.track_params)
+    visitor.track_id = 2
+    for t in (stander, visitor):
+        t.confirmed = True
+    stander.update_kind, visitor.update_kind = None, "moving"  # the visitor took a moving candidate this scan
+    sigma = tracker.pairing.sigma_pair_m
+
+    def standing(a, b):
+        return PersonCandidate(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), sigma, "standing", legs=(a, b))
+
+    tracker._tracks = [stander, visitor]
+    assert tracker._update_standing([standing((4.45, 0.0), (4.02, 0.17))]) == set()  # one leg is the visitor's
+    assert tracker._update_standing([standing((4.30, 0.0), (4.46, 0.12))]) == {0}  # both are the stander's
+    stander.update_kind = None
+    tracker._tracks = [stander]  # with nobody else there, the first pair would do
+    assert tracker._update_standing([standing((4.45, 0.0), (4.02, 0.17))]) == {0}
+
+
+def test_static_support_leaves_a_walkers_leg_to_the_walker():
+    """Someone standing (legs at y = 0 and -0.2 m) and a walker who took a moving candidate
+    this scan, their track 0.45 m away and their standing leg 0.3 m beside the person: the
+    standing track's support is its own two legs. Beside someone who is not walking (a
+    neighbour standing), and for a track that walks itself (a walker in stance phase or
+    hidden, whose prediction may lag behind their legs), every reading near the track counts
+    as before."""
+    from people_tracker.models.pose import Pose2D
+
+    sim, _ = build_simulation({"duration_s": 1, "laser": {"fov_deg": 270, "resolution_deg": 0.35, "rate_hz": 10,
+                                                           "range_max": 20, "noise_std": 0.0},
+                               "world": {"room": [-1, -6, 6, 6],
+                                         "pillars": [[3.0, 0.0, 0.06], [3.0, -0.2, 0.06], [3.0, 0.3, 0.06]]}})
+    scan = sim.step().scan
+    tracker = PeopleTracker.from_config(load_config())
+    stander, _ = new_track(x=3.0, y=-0.1, params=tracker.track_params, standing=True)
+    walker, _ = new_track(x=3.0, y=0.45, params=tracker.track_params)
+    walker.track_id = 2
+    for t in (stander, walker):
+        t.confirmed = True
+    tracker._tracks = [stander, walker]
+
+    def support():
+        found = tracker._static_support(np.array([stander.position]), scan, Pose2D())
+        tracker._support_without_walkers_legs([0], found, scan, Pose2D())
+        return found[0]
+
+    walker.update_kind = "moving"
+    assert stander.still
+    assert abs(support()[1] + 0.1) < 0.03  # between the standing person's own legs
+    walker.update_kind = "static"  # a neighbour standing: all three legs, pulled towards them
+    assert support()[1] > -0.02
+    walker.update_kind = "moving"  # a walker's track on the place (stance phase): all readings, as before
+    stander, _ = new_track(x=3.0, y=-0.1, params=tracker.track_params)
+    stander.confirmed = True
+    tracker._tracks = [stander, walker]
+    assert not stander.still
+    assert support()[1] > -0.02
+
+
+def test_someone_standing_never_takes_a_walkers_revealed_readings():
+    """Traced in the waiting room (seed 51, 352 s): a walker moving away from the laser
+    passed 0.45 m from someone standing; the candidate made of the walker's revealed
+    readings (``association.receding``) lay within a stance of the standing track, which
+    took it, walked off with the walker, and the two swapped ids five times."""
+    tracker = PeopleTracker.from_config(load_config())
+    stander, _ = new_track(x=3.77, y=-1.13, params=tracker.track_params, standing=True)
+    stander.confirmed = True
+    tracker._tracks = [stander]
+    sigma = tracker.pairing.sigma_single_leg_m
+    assert tracker._associate([PersonCandidate(3.70, -1.00, sigma, "receding")]) == []
+    assert tracker._associate([PersonCandidate(3.70, -1.00, sigma, "leg")]) == [(0, 0)]
