@@ -627,21 +627,22 @@ class PeopleTracker:
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
                 t.update(z, R, moving=False)
 
+    def _walkers_now(self) -> np.ndarray:
+        """Where the confirmed tracks that took a moving candidate this scan are (world frame,
+        m), shape (w, 2)."""
+        return np.array([t.position for t in self._tracks if t.confirmed and t.update_kind == "moving"]).reshape(-1, 2)
+
     def _nearer_a_walker(self, idx: list[int], xy: np.ndarray) -> np.ndarray:
         """Whether each place of ``xy`` (world frame, m) lies nearer another confirmed track
         that took a moving candidate this scan than the track ``idx[a]``: shape
-        (len(idx), len(xy)). A walker's standing leg beside someone is the walker's."""
-        walkers = [i for i, t in enumerate(self._tracks) if t.confirmed and t.update_kind == "moving"]
-        out = np.zeros((len(idx), len(xy)), dtype=bool)
-        if not walkers or not len(xy):
-            return out
-        d = pairwise_distances(np.array([self._tracks[i].position for i in walkers]), xy)  # (walkers, places)
+        (len(idx), len(xy)). A walker's standing leg beside someone is the walker's. (A
+        track of ``idx`` that is such a walker itself lies no nearer than itself: the strict
+        comparison leaves it out.)"""
+        walkers = self._walkers_now()
+        if not len(walkers) or not len(xy) or not len(idx):
+            return np.zeros((len(idx), len(xy)), dtype=bool)
         mine = pairwise_distances(np.array([self._tracks[i].position for i in idx]), xy)
-        for a, i in enumerate(idx):
-            others = d[[w != i for w in walkers]]
-            if len(others):
-                out[a] = others.min(axis=0) < mine[a]
-        return out
+        return pairwise_distances(walkers, xy).min(axis=0)[None, :] < mine
 
     def _support_without_walkers_legs(self, idle: list[int], found: list, scan: Scan, world: Pose2D) -> None:
         """Static support found for ``idle`` tracks, again without the readings that lie
@@ -650,8 +651,7 @@ class PeopleTracker:
         standing is the visitor's. Not for a walker's track (in stance phase or hidden, its
         prediction may lag behind their legs, nearer someone passing them)."""
         reach = 2.0 * self.assoc.support_radius_m
-        walkers = np.array([t.position for t in self._tracks
-                            if t.confirmed and t.update_kind == "moving"]).reshape(-1, 2)
+        walkers = self._walkers_now()
         near = [k for k, i in enumerate(idle) if found[k] is not None and self._tracks[i].still and
                 np.any(np.hypot(*(walkers - self._tracks[i].position).T) <= reach)]
         if not near:
