@@ -64,8 +64,10 @@ class DetectorParams:
         Δd_c of them (world frame). A walking leg is never twice at one place that long
         apart; a post the robot drives past always is. ``static_memory_k`` 0 turns it off.
         A reading counts as remembered when ``static_memory_min_scans`` of those scans saw
-        it; objects within ``static_memory_keep_m`` of a tracked person are kept (a person
-        turning back stands where they stood a moment before).
+        it; objects with moving readings within ``static_memory_keep_m`` of a tracked person
+        are kept (a person turning back stands where they stood a moment before). An object
+        of occluded readings alone is tested wherever it lies: a table leg a walker uncovers
+        is one, seen where it stood a second before.
     drop_carried
         Also drop objects carried by the robot (its own mast, a handle, a bumper the laser
         sees): at least half of their readings lie at the same place *in the sensor frame*
@@ -118,6 +120,7 @@ class _Past:
     pose: Pose2D | None
     tree: PointTree  # the valid readings, in the scan's own sensor frame
     moving: np.ndarray | None = None  # per beam: labelled moving when it was the current scan
+    static: np.ndarray | None = None  # per beam: labelled static when it was the current scan
 
 
 def _tree(scan: Scan) -> PointTree:
@@ -243,12 +246,15 @@ class MovingObjectDetector:
         return out
 
     def _static_memory(self, scan: Scan, pose: Pose2D | None, spans: list[tuple[int, int]], pts: np.ndarray,
-                       ranges: np.ndarray, people: np.ndarray | None = None) -> np.ndarray:
+                       ranges: np.ndarray, people: np.ndarray | None = None,
+                       moving: list[bool] | None = None) -> np.ndarray:
         """Which candidate objects (``spans`` of ``pts``, the valid readings in beam order,
         sensor frame) to keep: those whose place was not occupied in the scans about
         ``static_memory_s`` earlier (see :class:`DetectorParams`). Objects within
         ``static_memory_keep_m`` of ``people`` (tracked persons, sensor frame) are kept
-        whatever the memory says: a person turning back stands where they stood before."""
+        whatever the memory says when ``moving`` (per span; None: all) says they hold moving
+        readings: a person turning back stands where they stood before. Objects of occluded
+        readings alone are what a walker uncovers as often as a walker moving away."""
         p = self.params
         keep = np.ones(len(spans), dtype=bool)
         if not spans or p.static_memory_k <= 0:
@@ -259,21 +265,33 @@ class MovingObjectDetector:
         if p.drop_carried and pose is not None:
             keep &= ~self._carried(scan, pose, spans, pts, ranges, memory)
         test = np.arange(len(spans))
+        near = np.zeros(len(spans), dtype=bool)
         if people is not None and len(people):
             xy = means_and_chords([pts[a:b] for a, b in spans])[0]
-            d = pairwise_distances(xy, people).min(axis=1)
-            test = test[d > p.static_memory_keep_m]
+            near = pairwise_distances(xy, people).min(axis=1) <= p.static_memory_keep_m
+            exempt = near & (np.asarray(moving, dtype=bool) if moving is not None else True)
+            test = test[~exempt]
         if not len(test):
             return keep
         idx = np.concatenate([np.arange(*spans[k]) for k in test])
+        # near a person, only what was seen still a second ago counts: in a crowd someone
+        # else walked there
+        still_only = np.repeat(near[test], [spans[k][1] - spans[k][0] for k in test])
         q = pts[idx]
         thr = range_threshold(ranges[idx], scan.resolution, p.static_memory_k * p.k_closest,
                               p.static_memory_k * p.closest_floor_m)
         seen = np.zeros(len(q), dtype=np.int64)
         for past in memory:
             rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
-            d, _ = past.tree.query(rel.transform_points(q), float(thr.max()))
-            seen += d <= thr
+            d, j = past.tree.query(rel.transform_points(q), float(thr.max()))
+            hit = d <= thr
+            if still_only.any():
+                if past.static is None or not past.scan.n_valid:  # not labelled: nothing seen still
+                    hit &= ~still_only
+                else:
+                    beam = past.scan.valid_index[np.minimum(j, past.scan.n_valid - 1)]
+                    hit &= ~still_only | past.static[beam]
+            seen += hit
         share = _share_per_span(seen >= p.static_memory_min_scans, [spans[k] for k in test])
         keep[test[share >= p.static_memory_share]] = False
         return keep
@@ -339,6 +357,7 @@ class MovingObjectDetector:
             pairs.append(label_pair(scan, past.scan, rel, p, tree, past.tree))
         labels = combine(pairs)
         current.moving = labels == MOVING
+        current.static = labels == STATIC
         # 3. segments of each set, over the valid readings in beam order
         valid = scan.valid_index
         pts = scan.valid_points
@@ -354,7 +373,7 @@ class MovingObjectDetector:
         found = [seg for seg in found if seg.size >= p.min_object_points]
         # static things that flicker are not moving (extension, see DetectorParams)
         keep = self._static_memory(scan, pose, [(seg.start, seg.stop) for seg in found], pts,
-                                   scan.ranges[valid], people)
+                                   scan.ranges[valid], people, [MOVING in seg.sets for seg in found])
         # 5. position and box of each object big enough
         kept = [seg for seg, k in zip(found, keep) if k]
         objects = describe_all(self._next_id, [valid[seg.start:seg.stop] for seg in kept],
