@@ -87,7 +87,7 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
     x = tx[valid] + r * np.cos(a)
     y = ty[valid] + r * np.sin(a)
     new_r = np.hypot(x, y)
-    bearing = np.arctan2(y, x)
+    bearing = compiled.arctan2(y, x)
     idx = beam_index(bearing, scan.angle_min, increment, n)
     keep = (idx >= 0) & (new_r > scan.range_min) & (new_r < scan.range_max)
     out = np.where(scan.no_return, np.inf, np.nan)  # the sweep moves a line of sight by under a beam

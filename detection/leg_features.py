@@ -208,7 +208,7 @@ def _sides(scan: Scan, mean: np.ndarray, rng: np.ndarray, width: np.ndarray) -> 
         return np.zeros((len(mean), 2 * len(SIDE_OFFSETS_M)))
     offsets = np.array(SIDE_OFFSETS_M)
     across = (0.5 * width[:, None] + offsets[None, :]) / np.maximum(rng, 0.05)[:, None]  # (k, m) radians
-    bearing = np.arctan2(mean[:, 1], mean[:, 0])[:, None]
+    bearing = compiled.arctan2(mean[:, 1], mean[:, 0])[:, None]
     beam = scan.beam_of(np.concatenate([bearing - across, bearing + across], axis=1))  # (k, 2m)
     # the reading there, or the nearest real one within two beams of it (lost readings);
     # two real ones equally near, one either side: the nearer range, whichever way the

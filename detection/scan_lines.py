@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from people_tracker.detection.labels import MOVING, OCCLUDED, OUT_OF_VIEW
-from people_tracker.models.compiled import bin_of, njit
+from people_tracker.models.compiled import arctan2, bin_of, njit
 from people_tracker.models.scan import beam_index
 
 
@@ -18,7 +18,7 @@ def bin_to_beams(points: np.ndarray, angle_min: float, angle_increment: float, n
     points : ndarray, shape (m, 2)
         Points in the current sensor frame, metres.
     """
-    return beam_index(np.arctan2(points[:, 1], points[:, 0]), angle_min, angle_increment, n_beams)
+    return beam_index(arctan2(points[:, 1], points[:, 0]), angle_min, angle_increment, n_beams)
 
 
 def _nearest_per_beam(beam: np.ndarray, rng: np.ndarray, n_beams: int) -> np.ndarray:
