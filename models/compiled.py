@@ -16,7 +16,9 @@ the order ``np.add.reduceat`` adds, :func:`reduceat_sum`), and numba does not fu
 reorder floating-point operations unless asked to (``fastmath`` is off), so the results
 agree to the last bit on every scan the test has seen. One exception: an object's box
 sides (:func:`people_tracker.detection.objects.describe_all`), which shapely takes from
-corners GEOS intersects in double-double precision, agree to 1e-12 m. This module sits in ``models``,
+corners GEOS intersects in double-double precision, agree to 1e-12 m. The kernels' bearings
+come from the C library's atan2; numpy's arctan2 rounds differently on processors with
+AVX-512, so the numpy twins take :data:`arctan2`, which is the C library's there. This module sits in ``models``,
 beside :func:`people_tracker.models.scan.beam_index` whose one-bearing twin it holds, so
 that every layer can use it (the leg model too).
 """
