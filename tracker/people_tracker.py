@@ -228,8 +228,9 @@ class PeopleTracker:
         self._initiate_standing(standing, scan.stamp)  # 8b. and standing people who persist
         self._initiate_arrivals(arrivals, world, scan.stamp)  # 8c. and who arrived, legs merged or hidden
         self._delete(scan.stamp)  # 9. delete what the lifecycle rules end
-        target = self._follow(world, scan.stamp)  # 10. the followed person
-        reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.reported]
+        first = self._first_steps(scan.stamp)  # not reported yet
+        target = self._follow(world, scan.stamp, first)  # 10. the followed person
+        reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.reported and t not in first]
         self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing, legs, leg_scores)
         return reported
 
@@ -276,6 +277,7 @@ class PeopleTracker:
         for t, b, v in zip(self._tracks, best, vis):
             # nothing leg-like where something person-like updated it: a shape of 0
             leg = float(b) if b == b else (0.0 if t.updated_now else None)
+            t.visibility = int(v)
             t.weigh(int(v), leg)
 
     def _remember_hidden_stops(self, scan: Scan, world: Pose2D, vis: np.ndarray) -> None:
@@ -867,6 +869,21 @@ class PeopleTracker:
         return [u for u in tracks if stamp - u.born <= SET_OFF_S and
                 np.hypot(*(u.origin - t.position)) <= self.assoc.recover_radius_m]
 
+    def _first_steps(self, stamp: float) -> list[TrackState]:
+        """Young walking tracks that may be the first steps of someone still reported
+        standing beside them (born beside them, within ``association.recover_radius_m`` of
+        their place still): not reported yet. Either the standing one is gone (its place
+        seen empty, or its track dies) and the walking one takes its id (:meth:`_set_off`,
+        :meth:`_hand_over`), or the standing one takes the step and the walking one goes as
+        the same person twice; reported meanwhile, it showed the person under another id for
+        a few scans."""
+        standing = [t for t in self._tracks if t.reported and t.still and t.existence.walked_or_arrived]
+        if not standing:
+            return []
+        r = self.assoc.recover_radius_m
+        return [u for t in standing for u in self._born_beside(t, self._tracks, stamp)
+                if u.track_id > t.track_id and not u.still and np.hypot(*(u.position - t.position)) <= r]
+
     def _hand_over(self, t: TrackState, living: list[TrackState], stamp: float) -> bool:
         """A person who stood still and set off: their place empties (the standing track
         dies) while a new track starts beside it, which takes the standing one's id."""
@@ -882,11 +899,15 @@ class PeopleTracker:
         """Someone standing still who set off with a first step beyond reach: a walking
         track was born beside them and their standing track has had no update since it was
         confirmed (walked off; the trailing leg stays on the spot for the first step, so an
-        update or two after its birth is no sign that they stayed). Walking away along the
-        line of sight hides the place they left, so its emptiness may never be seen."""
+        update or two after its birth is no sign that they stayed), or the scan saw through
+        the place they stood (they are gone: their track would die of it within a few
+        scans, and hand its id over then, while the walking one is reported under its own).
+        Walking away along the line of sight hides the place they left, so its emptiness
+        may never be seen."""
         if not (t.confirmed and t.existence.walked_or_arrived and t.still) or t.updated_now:
             return False
-        return any(u.confirmed and not u.still and u.confirmed_at >= t.last_update
+        gone = t.visibility == SEEN_THROUGH
+        return any(u.confirmed and not u.still and (gone or u.confirmed_at >= t.last_update)
                    for u in self._born_beside(t, self._tracks, stamp))
 
     def _delete(self, stamp: float) -> None:
@@ -899,8 +920,9 @@ class PeopleTracker:
             self._hand_over(t, keep, stamp)
         self._tracks = keep
 
-    def _follow(self, world: Pose2D, stamp: float) -> int | None:
-        """The followed person's track id (see :mod:`people_tracker.tracker.following`)."""
+    def _follow(self, world: Pose2D, stamp: float, unreported: list[TrackState] = ()) -> int | None:
+        """The followed person's track id (see :mod:`people_tracker.tracker.following`);
+        the tracks of ``unreported`` are not offered to it."""
         sel = self.selector
         if sel is None:
             return None
@@ -932,12 +954,12 @@ class PeopleTracker:
                     t = self._retire(t)
                     sel.lost(stamp)
             if sel.lost_since is not None:
-                others = [u for u in self._tracks if u.track_id != sel.target and u.reported]
+                others = [u for u in self._tracks if u.track_id != sel.target and u.reported and u not in unreported]
                 new_id = sel.reacquire(stamp, here(others), {u.track_id: u.velocity for u in others})
                 if new_id is not None:
                     new = next(u for u in self._tracks if u.track_id == new_id)
                     new.track_id = sel.target  # the person keeps their id
-        reported = here(u for u in self._tracks if u.reported)
+        reported = here(u for u in self._tracks if u.reported and u not in unreported)
         target = sel.choose(reported)
         if target is not None and sel.expected(stamp) is None and target in reported:
             sel.seen(stamp, reported[target], next(u.velocity for u in self._tracks if u.track_id == target))

@@ -573,6 +573,57 @@ def test_someone_who_sets_off_hands_their_id_to_their_walking_track_after_the_tr
     assert not tracker._set_off(stander, 0.93)
 
 
+def _stander_and_first_step(tracker):
+    """Someone standing for ten seconds (id 1) and a walking track born 0.6 m from them
+    0.5 s ago and confirmed since (id 2), both weighed at 1.0 s; the stander was last
+    updated at 0.93 s, after the walker's confirmation."""
+    stander, _ = new_track(x=5.25, y=1.31, params=tracker.track_params, standing=True)
+    stander.confirmed, stander.moved = True, True
+    stander.existence.walked_or_arrived = True
+    stander.last_moving_update = -10.0
+    walker, _ = new_track(x=5.85, y=1.31, params=tracker.track_params)
+    walker.track_id = 2
+    walker.born, walker.confirmed_at = 0.5, 0.8
+    stander.last_update = 0.93
+    for t in (stander, walker):
+        t.stamp = 1.0
+        t.update_kind = None
+    walker.update_kind, walker.last_moving_update, walker.last_update = "moving", 1.0, 1.0
+    tracker._tracks = [stander, walker]
+    assert stander.still and not walker.still and stander.reported
+    return stander, walker
+
+
+def test_someone_whose_place_is_seen_empty_hands_their_id_to_their_first_step_at_once():
+    """Traced in the waiting room (seed 21, person 2 at 277 s): the standing track's place
+    was seen empty for 0.4 s before its existence fell low enough to end it, and until then
+    the person's walking track was reported under its own id."""
+    from people_tracker.detection.free_space import OCCUPIED, SEEN_THROUGH
+    tracker = PeopleTracker.from_config(load_config())
+    stander, walker = _stander_and_first_step(tracker)
+    stander.visibility = OCCUPIED  # something still there: they may be standing yet
+    assert not tracker._set_off(stander, 1.0)
+    stander.visibility = SEEN_THROUGH  # their place seen empty: they are the walker
+    assert tracker._set_off(stander, 1.0)
+    tracker._delete(1.0)
+    assert [t.track_id for t in tracker._tracks] == [1] and tracker._tracks[0] is walker
+
+
+def test_a_first_step_beside_someone_standing_is_not_reported_apart_from_them():
+    """Traced in the waiting room (seeds 22 and 23): the track of someone's first step was
+    reported beside their standing track for a scan or more under its own id, then either
+    took the standing id or went as the same person twice. While it stays within reach of
+    the standing place it is not reported; once it has walked beyond reach it is."""
+    tracker = PeopleTracker.from_config(load_config())
+    stander, walker = _stander_and_first_step(tracker)
+    assert tracker._first_steps(1.0) == [walker]
+    walker.kf.x[0] = 5.25 + tracker.assoc.recover_radius_m + 0.1  # walked beyond reach
+    assert tracker._first_steps(1.0) == []
+    walker.kf.x[0] = 5.85
+    walker.born = 1.0 - 3.5  # born longer ago than a first step
+    assert tracker._first_steps(1.0) == []
+
+
 def test_a_walkers_leg_never_pairs_away_from_them_with_a_leg_nobody_owns():
     p = PairingParams()  # a stride 0.8 m: half a stride 0.4 m
     from people_tracker.tracker.pairing import owners
