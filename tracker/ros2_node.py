@@ -178,7 +178,13 @@ def run_node(options: NodeOptions, config, ros_args: list[str] | None = None) ->
                 log.warning("no scan on %s for %.0f s", p["scan_topic"], NO_SCAN_WARN_S)
 
     try:
-        node.create_subscription(LaserScan, p["scan_topic"], on_scan, qos_profile_sensor_data)
+        # best effort, as a laser driver publishes, but holding as many scans as the queue:
+        # the sensor-data profile's 5 lost scans silently whenever the callback waited
+        # (a kernel loading at the start) instead of in the queue, which says so
+        sensor = qos_profile_sensor_data
+        scan_qos = QoSProfile(history=sensor.history, depth=max(int(p["queue"]), sensor.depth),
+                              reliability=sensor.reliability, durability=sensor.durability)
+        node.create_subscription(LaserScan, p["scan_topic"], on_scan, scan_qos)
         if p["odom_topic"]:
             node.create_subscription(Odometry, p["odom_topic"], on_odom, QoSProfile(depth=200))
     except NameValidationException as exc:  # --scan-topic "front scan"
