@@ -64,7 +64,6 @@ def numba_version() -> str | None:
     return _numba.__version__ if _numba is not None else None
 
 
-
 _C_ATAN2 = np.frompyfunc(math.atan2, 2, 1)  # the C library's atan2 (CPython's math.atan2), per element
 
 
@@ -88,6 +87,7 @@ def _numpy_arctan2_is_the_c_librarys() -> bool:
 # library does (as the kernels do), else the C library's, element by element (slower:
 # about 0.1 ms for 768 bearings, and only without numba or with it switched off)
 arctan2 = np.arctan2 if _numpy_arctan2_is_the_c_librarys() else _c_arctan2
+
 
 KERNELS: list = []  # every kernel the pipeline calls (not the helpers they call), for the warm-up's test
 

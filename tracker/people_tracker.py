@@ -659,8 +659,9 @@ class PeopleTracker:
         if not near:
             return
         theirs = self._nearer_a_walker([idle[k] for k in near], world.transform_points(scan.valid_points))
+        base = np.zeros(scan.n_beams, dtype=bool) if self._explained is None else self._explained
         for k, mask in zip(near, theirs):
-            explained = np.zeros(scan.n_beams, dtype=bool) if self._explained is None else self._explained.copy()
+            explained = base.copy()
             explained[scan.valid_index[mask]] = True
             found[k] = self._static_support(self._tracks[idle[k]].position[None], scan, world, explained)[0]
 

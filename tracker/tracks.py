@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
+from people_tracker.detection.free_space import UNSEEN
 from people_tracker.models.motion import H, constant_velocity_FQ
 from people_tracker.tracker.existence import Existence, logit
 
@@ -99,7 +100,7 @@ class TrackState:
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
         self.seen_position = np.array([x, y])  # where the last update of any kind put it, m
         self.hidden_position: np.ndarray | None = None  # the last predicted place found hidden since the last update, m
-        self.visibility = 0  # what this scan saw of its place (free_space's code; UNSEEN when updated)
+        self.visibility = UNSEEN  # what this scan saw of its place (free_space's code; UNSEEN when updated)
         self.origin = np.array([x, y])
         self.recent_position = np.array([x, y])  # its position averaged over the last still_after_s, m
         self.existence = existence
