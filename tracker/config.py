@@ -178,6 +178,7 @@ class AssociationConfig:
     recover_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
     start_leg_probability: float = field(metadata=_spec(lo=0.0, hi=1.01))
     receding: bool = field(metadata=_spec())
+    set_off_speed_mps: float = field(metadata=_spec(lo=0.0, hi=10.0))
 
     def params(self):
         from people_tracker.tracker.people_tracker import AssociationParams

@@ -71,6 +71,11 @@ class AssociationParams:
         prediction that belong to no moving object and hold at least
         ``support_min_points`` readings the detector labelled ``OCCLUDED`` and lying by a
         leg-shaped segment (see :meth:`PeopleTracker._receding`). On by default.
+    set_off_speed_mps : float
+        How fast (m/s) someone standing still may have walked, unseen, since their standing
+        track was last updated: a walking track born within ``recover_radius_m`` plus this
+        times that time of where they stood may be their first steps (see
+        :meth:`PeopleTracker._born_beside`). A first step from rest is slower than a walk.
     """
 
     method: str = "gnn"
@@ -85,6 +90,7 @@ class AssociationParams:
     recover_radius_m: float = 0.8
     start_leg_probability: float = 0.5
     receding: bool = True
+    set_off_speed_mps: float = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,6 +123,11 @@ class StoodPlace:
 # m/s: a track this fast passing close by someone standing is a passer-by, not them twice (a
 # walker's estimated speed lags: one setting off or slowing beside them reads 0.4-0.5 m/s at 0.7)
 PASSING_MPS = 0.3
+def _within(gap_s: float, limit_s: float) -> float:
+    """``gap_s`` (s) when it lies in [0, ``limit_s``], else 0."""
+    return gap_s if 0.0 <= gap_s <= limit_s else 0.0
+
+
 SET_OFF_S = 3.0  # s: a track this young that began beside someone standing may be them, set off
 TURN_S = 1.0  # s: a walker whose legs were last seen moving this recently may have turned sharply
 HEADING_MPS = 0.5  # m/s: a track at least this fast has a heading its legs are spread along
@@ -865,10 +876,16 @@ class PeopleTracker:
 
     def _born_beside(self, t: TrackState, tracks: list[TrackState], stamp: float) -> list[TrackState]:
         """The tracks of ``tracks`` born within ``SET_OFF_S`` before ``stamp`` whose first
-        place lies within ``association.recover_radius_m`` of ``t``: someone standing there
-        who set off, perhaps."""
-        return [u for u in tracks if stamp - u.born <= SET_OFF_S and
-                np.hypot(*(u.origin - t.position)) <= self.assoc.recover_radius_m]
+        place lies within reach of ``t``: someone standing there who set off, perhaps. The
+        reach is ``association.recover_radius_m``, and as far again as they could have
+        walked at ``set_off_speed_mps`` between ``t``'s last update and the walking track's
+        birth (a walker the detector did not see move at once, revealed from behind
+        something nearer, is first found farther on), while that time is within
+        ``existence.report_unseen_s``: of someone unseen for longer nothing says where
+        they went."""
+        a, unseen_s = self.assoc, self.existence.report_unseen_s
+        return [u for u in tracks if stamp - u.born <= SET_OFF_S and np.hypot(*(u.origin - t.position)) <=
+                a.recover_radius_m + a.set_off_speed_mps * _within(u.born - t.last_update, unseen_s)]
 
     def _first_steps(self, stamp: float) -> list[TrackState]:
         """Young walking tracks that may be the first steps of someone still reported

@@ -624,6 +624,29 @@ def test_a_first_step_beside_someone_standing_is_not_reported_apart_from_them():
     assert tracker._first_steps(1.0) == []
 
 
+def test_a_first_step_found_farther_on_after_an_unseen_start_still_takes_the_id():
+    """Traced in the waiting room (seed 22, person 11 at 360 s): someone stood, half hidden
+    by something nearer, and set off; for 0.7 s nothing showed them moving, so their
+    walking track began 0.92 m from the standing one, beyond ``recover_radius_m`` (0.8 m),
+    and they walked out under a new id. The reach grows with the time since the standing
+    track's last update (at ``set_off_speed_mps``), but not for someone unseen for longer
+    than ``report_unseen_s``: nothing says where they went."""
+    from people_tracker.detection.free_space import SEEN_THROUGH
+    tracker = PeopleTracker.from_config(load_config())
+    stander, walker = _stander_and_first_step(tracker)
+    walker.kf.x[0] = walker.origin[0] = 5.25 + 0.92  # born 0.92 m from them ...
+    walker.born, stander.last_update = 0.8, 0.07  # ... 0.73 s after their last update
+    stander.born = -10.0
+    stander.visibility = SEEN_THROUGH
+    assert tracker.assoc.recover_radius_m < 0.92 < tracker.assoc.recover_radius_m + 0.5 * 0.73
+    assert tracker._born_beside(stander, tracker._tracks, 1.0) == [walker]
+    assert tracker._set_off(stander, 1.0)
+    stander.last_update = walker.born - 0.1  # seen just before: only recover_radius_m
+    assert tracker._born_beside(stander, tracker._tracks, 1.0) == []
+    stander.last_update = walker.born - tracker.existence.report_unseen_s - 0.5  # unseen too long
+    assert tracker._born_beside(stander, tracker._tracks, 1.0) == []
+
+
 def test_a_walkers_leg_never_pairs_away_from_them_with_a_leg_nobody_owns():
     p = PairingParams()  # a stride 0.8 m: half a stride 0.4 m
     from people_tracker.tracker.pairing import owners
