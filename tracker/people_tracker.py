@@ -74,8 +74,9 @@ class AssociationParams:
     set_off_speed_mps : float
         How fast (m/s) someone standing still may have walked, unseen, since their standing
         track was last updated: a walking track born within ``recover_radius_m`` plus this
-        times that time of where they stood may be their first steps (see
-        :meth:`PeopleTracker._born_beside`). A first step from rest is slower than a walk.
+        times that time of where they stood may be their first steps, while that time is
+        within ``existence.report_unseen_s`` (see :meth:`PeopleTracker._born_beside`). A
+        first step from rest is slower than a walk.
     """
 
     method: str = "gnn"
@@ -123,11 +124,6 @@ class StoodPlace:
 # m/s: a track this fast passing close by someone standing is a passer-by, not them twice (a
 # walker's estimated speed lags: one setting off or slowing beside them reads 0.4-0.5 m/s at 0.7)
 PASSING_MPS = 0.3
-def _within(gap_s: float, limit_s: float) -> float:
-    """``gap_s`` (s) when it lies in [0, ``limit_s``], else 0."""
-    return gap_s if 0.0 <= gap_s <= limit_s else 0.0
-
-
 SET_OFF_S = 3.0  # s: a track this young that began beside someone standing may be them, set off
 TURN_S = 1.0  # s: a walker whose legs were last seen moving this recently may have turned sharply
 HEADING_MPS = 0.5  # m/s: a track at least this fast has a heading its legs are spread along
@@ -987,6 +983,11 @@ class PeopleTracker:
         """The track ``t`` goes on under a new id (it is no longer the followed person)."""
         t.track_id, self._next_id = self._next_id, self._next_id + 1
         return None
+
+
+def _within(gap_s: float, limit_s: float) -> float:
+    """``gap_s`` (s) when it lies in [0, ``limit_s``], else 0."""
+    return gap_s if 0.0 <= gap_s <= limit_s else 0.0
 
 
 def _headings(tracks: list[TrackState]) -> np.ndarray:
