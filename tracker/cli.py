@@ -7,6 +7,7 @@ bad scans inside a good recording give one warning each and the run goes on.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import re
@@ -216,18 +217,21 @@ def _cmd_run(args) -> int:
     check_outputs([args.input, args.config], _run_outputs(args))
     t0 = time.perf_counter()
     truth = _ground_truth_by_scan(args.input, args.topic) if (args.rrd or args.spawn) and args.input else None
-    sink = _make_sink(args)
-    try:
-        if args.input is None:
-            from people_tracker.tracker.io.simulated import DEFAULT_SCENE, SimulatedSource
-            source = SimulatedSource(DEFAULT_SCENE)
-        else:
-            source = Recording(args.input, args.topic, config.odometry)
-        _run_loop(args, config, follow, source, contextlib.ExitStack(), sink, truth, t0)
-    except BaseException:
-        sink.abort()
-        raise
-    sink.close()
+    with _ctrl_c_latch() as interrupted:
+        sink = _make_sink(args)
+        try:
+            if args.input is None:
+                from people_tracker.tracker.io.simulated import DEFAULT_SCENE, SimulatedSource
+                source = SimulatedSource(DEFAULT_SCENE)
+            else:
+                source = Recording(args.input, args.topic, config.odometry)
+            _run_loop(args, config, follow, source, contextlib.ExitStack(), sink, truth, t0, interrupted)
+            if interrupted():
+                raise KeyboardInterrupt
+        except BaseException:
+            sink.abort()
+            raise
+        sink.close()
     return 0
 
 
@@ -257,7 +261,10 @@ def _make_sink(args):
     return RerunSink(args.rrd, args.spawn)
 
 
-def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
+def _run_loop(args, config, follow, source, stack, sink, truth, t0, interrupted=lambda: False) -> None:
+    """Track every scan of ``source``, writing the outputs; ``interrupted`` says whether
+    Ctrl-C came (see :func:`_ctrl_c_latch`): the run then ends before the next scan, and
+    before anything is published."""
     import logging
 
     import numpy as np
@@ -292,6 +299,8 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
         last_pose = None
         with _progress(rec.scan_count, args.quiet) as bar:
             for record in rec.scans():
+                if interrupted():
+                    raise KeyboardInterrupt
                 bar.update(1)
                 verdict = checker.check(record.scan, record.problem)
                 if verdict.reason:
@@ -335,6 +344,8 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0) -> None:
                     if last_pose is not None:
                         path_m += math.hypot(record.pose.x - last_pose.x, record.pose.y - last_pose.y)
                     last_pose = record.pose
+            if interrupted():  # Ctrl-C during the last scan: nothing is published
+                raise KeyboardInterrupt
         elapsed = time.perf_counter() - t0
         span = (last_stamp - first_stamp) if used > 1 else 0.0
         rate = f", {(used - 1) / span:.1f} Hz" if span > 0 else ""
@@ -501,6 +512,35 @@ def _cmd_replay(args) -> int:
     from people_tracker.tracker.ros2_node import replay
 
     return replay(args.input, args.topic, args.rate, load_config(), args.wait, args.ros_args)
+
+
+@contextlib.contextmanager
+def _ctrl_c_latch():
+    """Ctrl-C during a run, remembered as well as raised: yields a function that says
+    whether it came. A KeyboardInterrupt raised while a library's compiled code runs may
+    never reach the loop (a CI run once ended ``run --rrd`` with exit status 0 after
+    Ctrl-C, its outputs published); the loop asks at every scan and ends the run then. Left
+    alone where Ctrl-C is not Python's to handle: ignored (a run started in the background
+    by a shell inherits that), handled by someone else, or off the main thread."""
+    import signal
+    import threading
+
+    came = False
+
+    def handler(signum, frame):
+        nonlocal came
+        came = True
+        raise KeyboardInterrupt
+
+    ours = (threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+    if ours:
+        signal.signal(signal.SIGINT, handler)
+    try:
+        yield lambda: came
+    finally:
+        if ours:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _interrupted(exc: BaseException) -> bool:

@@ -119,6 +119,32 @@ def test_ctrl_c_ends_a_run_with_130_and_no_files(tmp_path, extra):
     assert os.listdir(tmp_path) == []
 
 
+def test_ctrl_c_that_a_library_swallows_still_ends_the_run():
+    """A CI run once saw ``run --rrd`` exit 0 after Ctrl-C, its outputs published: the
+    KeyboardInterrupt never reached the loop (raised inside a library's compiled code and
+    dropped there, most likely). The run's handler remembers Ctrl-C as well as raising it,
+    and puts Python's own back after; where Ctrl-C is ignored it is left ignored."""
+    from people_tracker.tracker.cli import _ctrl_c_latch
+
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    with _ctrl_c_latch() as interrupted:
+        assert not interrupted()
+        try:  # what a library that drops the exception does
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.5)  # the handler runs at the next bytecode
+        except KeyboardInterrupt:
+            pass
+        assert interrupted()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # started in the background by a shell
+    try:
+        with _ctrl_c_latch() as interrupted:
+            assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN and not interrupted()
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def test_evaluate_warns_when_the_files_come_from_different_recordings(tmp_path):
     tracks = tmp_path / "t.csv"
     tracks.write_text("scan_index,track_id,x,y\n0,1,1.0,0.0\n1562,1,1.0,0.0\n")
