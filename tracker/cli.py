@@ -200,8 +200,6 @@ def _run_header(args, rec) -> str:
 
 
 def _cmd_run(args) -> int:
-    import contextlib
-
     from people_tracker.tracker.config import load_config
     from people_tracker.tracker.io.atomic import check_outputs
     from people_tracker.tracker.io.recording import Recording

@@ -284,7 +284,6 @@ class PeopleTracker:
         for t, b, v in zip(self._tracks, best, vis):
             # nothing leg-like where something person-like updated it: a shape of 0
             leg = float(b) if b == b else (0.0 if t.updated_now else None)
-            t.visibility = int(v)
             t.weigh(int(v), leg)
 
     def _remember_hidden_stops(self, scan: Scan, world: Pose2D, vis: np.ndarray) -> None:

@@ -180,7 +180,9 @@ class TrackState:
         return not self.moved or self.last_update - self.last_moving_update >= self.params.still_after_s
 
     def weigh(self, visibility: int, leg_probability: float | None) -> None:
-        """Book this scan's evidence of existence; confirm when it is strong enough."""
+        """Book this scan's evidence of existence (``visibility``: what the scan saw of its
+        place, kept as :attr:`visibility`); confirm when it is strong enough."""
+        self.visibility = visibility
         # the existence's stamp is the last scan weighed
         a = 1.0 - math.exp(-(self.stamp - self.existence.stamp) / max(self.params.still_after_s, 1e-6))
         self.recent_position += a * (self.position - self.recent_position)
