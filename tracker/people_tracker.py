@@ -77,6 +77,12 @@ class AssociationParams:
         times that time of where they stood may be their first steps, while that time is
         within ``existence.report_unseen_s`` (see :meth:`PeopleTracker._born_beside`). A
         first step from rest is slower than a walk.
+    contested_set_off_probability : float
+        A moving candidate within the gate of someone standing still and of a confirmed
+        walker: the prior probability that it is the standing person's first step rather
+        than the walker's leg. The standing track pays ``-2 ln`` of it on top of its squared
+        Mahalanobis distance (a walker passing close by someone standing must not carry
+        their track off); 1 turns it off.
     """
 
     method: str = "gnn"
@@ -92,6 +98,7 @@ class AssociationParams:
     start_leg_probability: float = 0.5
     receding: bool = True
     set_off_speed_mps: float = 0.5
+    contested_set_off_probability: float = 0.1
 
 
 @dataclass(frozen=True, eq=False)
@@ -533,6 +540,15 @@ class PeopleTracker:
             # a walker's revealed readings are theirs: someone standing is not revealed behind themselves
             receding = np.array([c.kind == "receding" for c in candidates])
             cost[still[:, None] & receding[None, :]] = np.inf
+            # a moving leg that a confirmed walker's gate holds as well is more likely theirs
+            # than someone standing's first step: a walker passing close by someone standing
+            # (their legs seen together in one segment) must not carry the standing person's
+            # track off with them. It costs the standing track -2 ln P(a first step).
+            walking = np.array([t.confirmed and not t.still for t in self._tracks])
+            p_set_off = self.assoc.contested_set_off_probability
+            if walking.any() and p_set_off < 1.0:
+                held = (cost[walking] <= self.assoc.gate_chi2).any(axis=0)
+                cost[np.ix_(still, held)] -= 2.0 * math.log(max(p_set_off, 1e-12))
         # one assignment for every track; a tentative track pays -2 ln P(it exists) on top of
         # the squared Mahalanobis distance (a pairing's negative log-likelihood), so a new
         # track on someone's second leg gives way to their confirmed track, while a passer-by's

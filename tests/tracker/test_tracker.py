@@ -794,3 +794,36 @@ def test_someone_standing_never_takes_a_walkers_revealed_readings():
     sigma = tracker.pairing.sigma_single_leg_m
     assert tracker._associate([PersonCandidate(3.70, -1.00, sigma, "receding")]) == []
     assert tracker._associate([PersonCandidate(3.70, -1.00, sigma, "leg")]) == [(0, 0)]
+
+
+def test_a_walker_passing_close_keeps_their_leg_from_someone_standing():
+    """Traced in the waiting room (seed 62, 132 s): a walker passed 0.44 m from someone who
+    had stood for 100 s, behind them; as the walker came out, their leg and the standing
+    person's were seen as one moving segment 0.19 m from the standing track and 0.39 m from
+    the walker's prediction. The standing track took it (squared Mahalanobis 0.93 against
+    2.60), walked off with the walker, and the two swapped ids. A moving leg within both
+    gates costs the standing track ``-2 ln contested_set_off_probability`` more."""
+    tracker = PeopleTracker.from_config(load_config())
+    stander, _ = new_track(x=2.05, y=2.76, params=tracker.track_params, standing=True)
+    stander.confirmed, stander.moved, stander.last_moving_update = True, True, -90.0
+    stander.kf.P[::2, ::2] = 0.0034 * np.eye(2)  # state order [x, vx, y, vy]
+    walker, _ = new_track(x=2.29, y=3.23, params=tracker.track_params)
+    walker.track_id = 2
+    walker.confirmed, walker.moved, walker.last_moving_update = True, True, 0.0
+    walker.kf.P[::2, ::2] = 0.015 * np.eye(2)
+    walker.kf.x[1::2] = [-1.1, -0.5]
+    tracker._tracks = [stander, walker]
+    assert stander.still and not walker.still
+    sigma = tracker.pairing.sigma_single_leg_m
+    merged = PersonCandidate(2.02, 2.95, sigma, "leg")
+    assert tracker._associate([merged]) == [(1, 0)]
+    # the standing person's own leg beside them is still theirs, though the walker's gate holds it
+    own = PersonCandidate(2.05, 2.66, sigma, "leg")
+    assert tracker._associate([own]) == [(0, 0)]
+    # with nobody walking by, the standing person takes the merged segment as before
+    tracker._tracks = [stander]
+    assert tracker._associate([merged]) == [(0, 0)]
+    off = config_from_dict({"association": {"contested_set_off_probability": 1.0}})
+    tracker = PeopleTracker.from_config(off)
+    tracker._tracks = [stander, walker]
+    assert tracker._associate([merged]) == [(0, 0)]
