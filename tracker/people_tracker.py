@@ -19,7 +19,7 @@ import numpy as np
 from people_tracker.detection.align import Alignment, AlignParams, ScanAligner
 from people_tracker.detection.detector import Detection, DetectorParams, MovingObjectDetector
 from people_tracker.detection import labels as L
-from people_tracker.detection.free_space import (OCCLUDED, SEEN_THROUGH, UNSEEN, PlaceMemory, place_visibility,
+from people_tracker.detection.free_space import (OCCLUDED, OCCUPIED, SEEN_THROUGH, UNSEEN, PlaceMemory, place_visibility,
                                                  seen_through)
 from people_tracker.detection.leg_features import LegCandidates, leg_candidates
 from people_tracker.detection.segments import means_and_chords
@@ -947,7 +947,25 @@ class PeopleTracker:
             if t.furniture() and t.existence.probability >= self.existence.delete:
                 self.standing.furniture(t.position)
             self._hand_over(t, keep, stamp)
+            self._remember_ended_out_of_sight(t, stamp)
         self._tracks = keep
+
+    def _remember_ended_out_of_sight(self, t: TrackState, stamp: float) -> None:
+        """A confirmed walker whose track ends out of sight (its predicted place was hidden
+        since its last update, and is hidden or occupied now: not seen empty) may have
+        stopped there, behind
+        whoever hides them: the middle of the stretch from where they were last seen to
+        that place goes to the memory of where people stood, as a guess, with their id and
+        evidence (as :meth:`_remember_hidden_stops` does for a walker whose predicted place
+        comes out into the open). When the view clears, someone leg-like found there takes
+        their id back (:meth:`_reacquire_standing`); a place seen empty is forgotten."""
+        if not (t.confirmed and t.moved and not t.still and t.visibility in (OCCLUDED, OCCUPIED)
+                and t.hidden_position is not None):
+            return
+        if any(e.track_id == t.track_id for e in self._stood):
+            return
+        xy = 0.5 * (t.seen_position + t.hidden_position)
+        self._stood.append(StoodPlace(xy, stamp, t.track_id, t.seen_evidence, True, t.last_moving_update))
 
     def _follow(self, world: Pose2D, stamp: float, unreported: list[TrackState] = ()) -> int | None:
         """The followed person's track id (see :mod:`people_tracker.tracker.following`);

@@ -100,6 +100,7 @@ class TrackState:
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
         self.seen_position = np.array([x, y])  # where the last update of any kind put it, m
         self.hidden_position: np.ndarray | None = None  # the last predicted place found hidden since the last update, m
+        self.seen_evidence = existence.l_dyn  # its existence evidence (log-odds) when last updated
         self.visibility = UNSEEN  # what this scan saw of its place (free_space's code; UNSEEN when updated)
         self.origin = np.array([x, y])
         self.recent_position = np.array([x, y])  # its position averaged over the last still_after_s, m
@@ -163,6 +164,7 @@ class TrackState:
         self.last_update = self.stamp
         self.seen_position = self.position.copy()
         self.hidden_position = None
+        self.seen_evidence = self.existence.l_dyn
         if moving:
             self.moved = True
             self.last_moving_update = self.stamp

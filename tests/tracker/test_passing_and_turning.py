@@ -454,3 +454,43 @@ def test_a_revealed_surface_with_no_leg_shape_is_no_receding_walker():
     # revealed step by step too): its readings are revealed, but nothing there is leg-shaped
     wall = _scan([], walls=[[2.8, -0.3, 3.4, 0.1]])
     assert _walker_at_legs((1.0, 0.0), scan=wall) == []
+
+
+def test_a_walker_whose_track_ends_out_of_sight_gets_their_id_back_where_they_stopped():
+    """Traced in the waiting room (development seed 61, person 11 at 218 s): someone walked
+    behind a person standing nearer the laser and stopped there, out of sight; their track
+    coasted on, hidden, and ended. When the nearer person left 110 s later they stood in
+    full view, and were found again only as a stranger (a new id, reported late). A walker
+    whose track ends while its predicted place is hidden or occupied, never seen empty, is
+    remembered as a guess of where they stand; the place seen empty forgets it."""
+    import dataclasses
+
+    from people_tracker.detection.free_space import OCCLUDED, SEEN_THROUGH
+    from people_tracker.detection.leg_features import leg_candidates
+
+    def walker(visibility):
+        t = _two_tracks()._tracks[0]  # a confirmed walking track (born moving)
+        t.track_id, t.visibility = 7, visibility
+        t.seen_position, t.hidden_position, t.seen_evidence = np.array([2.8, 0.0]), np.array([3.2, 0.0]), 3.0
+        return t
+
+    tracker = PeopleTracker.from_config(load_config())
+    gone = walker(SEEN_THROUGH)  # their predicted place seen empty: they walked on
+    tracker._remember_ended_out_of_sight(gone, 10.0)
+    assert tracker._stood == []
+    t = walker(OCCLUDED)
+    assert t.moved and not t.still and t.confirmed
+    tracker._remember_ended_out_of_sight(t, 10.0)
+    [e] = tracker._stood
+    assert e.guess and e.track_id == 7 and e.l_dyn == 3.0 and np.allclose(e.xy, [3.0, 0.0])
+    tracker._remember_ended_out_of_sight(t, 10.5)  # once
+    assert len(tracker._stood) == 1
+
+    empty, there = _scan([]), _scan([[3.0, 0.1, 0.06], [3.0, -0.12, 0.06]])  # their two legs
+    for stamp in np.arange(-30.0, 0.0, 1.0):  # the floor seen empty before they came
+        tracker.places.add(dataclasses.replace(empty, stamp=float(stamp)), Pose2D())
+    seen = dataclasses.replace(there, stamp=120.0)
+    legs = leg_candidates(seen)
+    tracker._legs_world, tracker._leg_scores = legs.xy, tracker.leg_model.probability(legs.features)
+    tracker._reacquire_standing(seen, Pose2D())
+    assert [u.track_id for u in tracker._tracks] == [7]
