@@ -312,7 +312,7 @@ class PeopleTracker:
                 walkers.append(t)
         if not walkers:
             return
-        middle = np.array([0.5 * (t.seen_position + t.hidden_position) for t in walkers])
+        middle = np.array([t.hidden_stretch_middle for t in walkers])
         hidden = place_visibility(middle, scan, world, self.existence.place_radius_m,
                                   self.detector.params.no_return_free_m) == OCCLUDED
         for t, xy, h in zip(walkers, middle, hidden):
@@ -544,9 +544,9 @@ class PeopleTracker:
             # than someone standing's first step: a walker passing close by someone standing
             # (their legs seen together in one segment) must not carry the standing person's
             # track off with them. It costs the standing track -2 ln P(a first step).
-            walking = np.array([t.confirmed and not t.still for t in self._tracks])
             p_set_off = self.assoc.contested_set_off_probability
-            if walking.any() and p_set_off < 1.0:
+            walking = ~still & np.array([t.confirmed for t in self._tracks])
+            if p_set_off < 1.0 and walking.any():
                 held = (cost[walking] <= self.assoc.gate_chi2).any(axis=0)
                 cost[np.ix_(still, held)] -= 2.0 * math.log(max(p_set_off, 1e-12))
         # one assignment for every track; a tentative track pays -2 ln P(it exists) on top of
@@ -953,18 +953,17 @@ class PeopleTracker:
     def _remember_ended_out_of_sight(self, t: TrackState, stamp: float) -> None:
         """A confirmed walker whose track ends out of sight (its predicted place was hidden
         since its last update, and is hidden or occupied now: not seen empty) may have
-        stopped there, behind
-        whoever hides them: the middle of the stretch from where they were last seen to
-        that place goes to the memory of where people stood, as a guess, with their id and
-        evidence (as :meth:`_remember_hidden_stops` does for a walker whose predicted place
-        comes out into the open). When the view clears, someone leg-like found there takes
-        their id back (:meth:`_reacquire_standing`); a place seen empty is forgotten."""
-        if not (t.confirmed and t.moved and not t.still and t.visibility in (OCCLUDED, OCCUPIED)
-                and t.hidden_position is not None):
+        stopped there, behind whoever hides them: the middle of the hidden stretch of their
+        path goes to the memory of where people stood, as a guess, with their id and the
+        evidence the track had when last updated (as :meth:`_remember_hidden_stops` does for
+        a walker whose predicted place comes out into the open). When the view clears,
+        someone leg-like found there takes their id back (:meth:`_reacquire_standing`); a
+        place seen empty is forgotten."""
+        xy = t.hidden_stretch_middle
+        if not (xy is not None and t.confirmed and t.moved and not t.still and t.visibility in (OCCLUDED, OCCUPIED)):
             return
         if any(e.track_id == t.track_id for e in self._stood):
             return
-        xy = 0.5 * (t.seen_position + t.hidden_position)
         self._stood.append(StoodPlace(xy, stamp, t.track_id, t.seen_evidence, True, t.last_moving_update))
 
     def _follow(self, world: Pose2D, stamp: float, unreported: list[TrackState] = ()) -> int | None:

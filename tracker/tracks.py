@@ -175,6 +175,15 @@ class TrackState:
             self.update_kind = "static"
 
     @property
+    def hidden_stretch_middle(self) -> np.ndarray | None:
+        """The middle of the hidden stretch of its path (world frame, m), from where its last
+        update put it to the last predicted place found hidden since: the best guess of where
+        someone who stopped out of sight stands. None when no prediction was found hidden."""
+        if self.hidden_position is None:
+            return None
+        return 0.5 * (self.seen_position + self.hidden_position)
+
+    @property
     def still(self) -> bool:
         """Seen standing still: never moved, or updated by static evidence alone (leg pairs,
         static support) for ``still_after_s`` since its last moving update. Someone who
