@@ -19,6 +19,7 @@ Units: metres, seconds, world frame.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -32,14 +33,18 @@ GAP_M = 0.45
 def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, gap_m: float = GAP_M,
                dt_s: float = 0.1, lookahead_s: float = 1.0, sidestep_mps: float = 0.8, return_mps: float = 0.3,
                bounds: dict[int, tuple[float, float, float, float]] | None = None,
-               obstacles: np.ndarray | None = None, visitors: list[Walker] | None = None) -> None:
+               obstacles: np.ndarray | None = None, visitors: list[Walker] | None = None,
+               robot: Callable[[np.ndarray], np.ndarray] | None = None, robot_radius_m: float = 0.0) -> None:
     """Set ``detour`` on each of ``yielding`` (in order) so they keep ``gap_m`` from ``fixed``,
     from ``visitors`` and from the yielding walkers before them, and half of it from the edge
     of each round obstacle in ``obstacles`` (x, y, radius; m, world frame: pillars, trees,
     table legs). ``visitors`` (people who walk to a place, stand there a while and leave, as
     in a waiting room) step aside for everyone but the yielding, before them in the list or
     after, while they walk, and hold their place while they stand: whoever walks past
-    someone standing makes way. ``bounds`` maps a walker's ``person_id`` to an area
+    someone standing makes way. ``robot`` gives the robot base's place (m, world frame) at
+    each of an array of times (s): everyone keeps half of ``gap_m`` from its edge, a disc of
+    ``robot_radius_m``, as from a round obstacle that moves (the robot drives on and makes
+    way for nobody). ``bounds`` maps a walker's ``person_id`` to an area
     ``(x0, y0, x1, y1)`` their torso stays in. Walkers are changed in place."""
     visitors, bounds = list(visitors or []), bounds or {}
     if gap_m <= 0 or not (yielding or visitors):
@@ -51,13 +56,18 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
     # everyone placed so far, row by row: torso or obstacle centre (m) and velocity (m/s),
     # world frame, at each time; whether there; the gap to keep from them (m). Filled in
     # place, so that an hour's scene does not copy them all again for each walker
-    rows = len(obstacles) + len(fixed) + len(visitors) + len(yielding)
+    rows = len(obstacles) + (robot is not None) + len(fixed) + len(visitors) + len(yielding)
     pos, vel = np.zeros((rows, len(times), 2)), np.zeros((rows, len(times), 2))
     there, gaps = np.zeros((rows, len(times)), dtype=bool), np.zeros(rows)
     pos[:len(obstacles)] = obstacles[:, None, :2]
     there[:len(obstacles)] = True
     gaps[:len(obstacles)] = obstacles[:, 2] + 0.5 * gap_m
     m = len(obstacles)
+    if robot is not None:  # a round obstacle that drives
+        where = np.asarray(robot(times), dtype=float).reshape(len(times), 2)
+        pos[m], there[m], gaps[m] = where, True, robot_radius_m + 0.5 * gap_m
+        vel[m] = np.gradient(where, dt_s, axis=0) if len(times) > 1 else 0.0
+        m += 1
 
     def place(row: int, where: np.ndarray, present: np.ndarray) -> None:
         pos[row], there[row], gaps[row] = where, present, gap_m

@@ -13,6 +13,7 @@ file, radians inside)::
     robot: {start: [x, y, yaw_deg], mount: [x, y, yaw_deg],
             drive: [[duration_s, v_mps, omega_degps], ...] | waypoints: [[x, y]], speed: m/s,
             odometry_noise: {trans: fraction, rot: rad per rad}, odometry: bool (default true),
+            radius_m: 0.3 (its footprint round the base, which people walk round; 0: none),
             follow: {person, distance, max_speed, max_turn_degps, trail: bool,
                      hold: {at: [[x, y], ...], radius_m, seconds}, beside: {windows: [[t0, t1]], offset_m}}}
     people: [{id, path: [[x, y], ...], speed: m/s or list, start_s, pauses: {waypoint: s},
@@ -41,7 +42,8 @@ person with their true position (see :class:`~people_tracker.models.robot.Follow
 
 Crowd members and passers-by step aside rather than walk through anyone: each keeps
 ``keep_apart_m`` between torsos from the people listed, the visitors and those of them drawn
-before, and half of it from pillars, trees and furniture legs
+before, and half of it from pillars, trees and furniture legs and from the edge of the
+robot's footprint (``robot.radius_m`` round its base; the robot makes way for nobody)
 (:func:`~people_tracker.models.keep_apart.keep_apart`; crowd members within their area).
 Visitors do the same while they walk, for the people listed and every other visitor (whoever
 walks past someone standing makes way), and hold their place while they stand.
@@ -63,7 +65,7 @@ from people_tracker.models.keep_apart import GAP_M, keep_apart
 from people_tracker.models.laser import LaserModel
 from people_tracker.models.person import PersonModel, Walker
 from people_tracker.models.pose import Pose2D
-from people_tracker.models.robot import FollowDriver, ScriptedDriver, WaypointDriver
+from people_tracker.models.robot import FollowDriver, ScriptedDriver, WaypointDriver, integrate
 from people_tracker.models.simulator import Simulation
 from people_tracker.models.world import World, build_world
 
@@ -73,6 +75,8 @@ class ScenarioError(ValueError):
 
 
 CROWD_AREA = [0, -5, 10, 5]  # m, world frame: where a crowd wanders unless told
+#: m: the robot's footprint, a disc round its base (``robot.radius_m``), that people walk round
+ROBOT_RADIUS_M = 0.3
 
 _KEYS = {
     "": {"description", "duration_s", "seed", "laser", "lasers", "world", "robot", "people", "crowd", "visitors",
@@ -81,7 +85,7 @@ _KEYS = {
               "dropout_value", "spurious", "clockwise", "frame_id", "sweep_fraction"},
     "world": {"room", "walls", "boxes", "pillars"},
     "robot": {"start", "mount", "drive", "waypoints", "speed", "max_turn_degps", "odometry_noise", "follow",
-              "odometry"},
+              "odometry", "radius_m"},
     "robot.follow": {"person", "distance", "max_speed", "max_turn_degps", "trail", "hold", "beside"},
     "robot.follow.hold": {"at", "radius_m", "seconds"},
     "robot.follow.beside": {"windows", "offset_m"},
@@ -440,16 +444,6 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
     robot = spec.get("robot", {}) or {}
     start = _pose(robot.get("start", [0, 0, 0]), "robot.start")
     mount = _pose(robot.get("mount", [0, 0, 0]), "robot.mount")
-    driver = None
-    if "drive" in robot:
-        try:
-            pieces = [(float(d), float(v), math.radians(float(w))) for d, v, w in robot["drive"]]
-        except (TypeError, ValueError):
-            raise ScenarioError("scenario key 'robot.drive' must be a list of [duration_s, v_mps, omega_degps]") from None
-        driver = ScriptedDriver(pieces)
-    elif "waypoints" in robot:
-        driver = WaypointDriver(robot["waypoints"], _num(robot, "speed", 0.8, "robot.", 0.0, 5.0),
-                                math.radians(_num(robot, "max_turn_degps", 60.0, "robot.", 0.0, 1000.0)))
     noise = robot.get("odometry_noise", {}) or {}
     walkers = [_walker(i, p, rng) for i, p in enumerate(spec.get("people", []) or [])]
     crowd: list[Walker] = []
@@ -475,12 +469,8 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
         if target is None:
             raise ScenarioError(f"scenario key 'robot.follow.person': no person with id {f.get('person')!r}")
         target_id = target.person_id
-        driver = FollowDriver(lambda t, w=target: w.torso(t) if w.present(t) else None,
-                              _num(f, "distance", 1.0, "robot.follow.", 0.1, 20.0),
-                              _num(f, "max_speed", 1.2, "robot.follow.", 0.0, 5.0),
-                              math.radians(_num(f, "max_turn_degps", 1.0, "robot.follow.", 1.0, 1000.0))
-                              if "max_turn_degps" in f else 1.5,
-                              bool(f.get("trail", False)), _hold(f.get("hold")), _beside(f.get("beside")))
+    make_driver = _driver_factory(robot, walkers, target_id)
+    driver = make_driver()
     passers: list[Walker] = []
     for p in _as_list(spec.get("passers")):
         pid = p.get("person", target_id if target_id is not None else walkers[0].person_id if walkers else None)
@@ -494,13 +484,63 @@ def build_simulation(spec: dict, seed: int | None = None, crowd_count: int | Non
     moved = {id(w) for w in yielding + visitors}
     fixed = [w for w in walkers if id(w) not in moved]  # the people listed
     area = _crowd_area(spec.get("crowd", {}) or {})
+    radius = _num(robot, "radius_m", ROBOT_RADIUS_M, "robot.", 0.0, 5.0)
     keep_apart(fixed, yielding, duration, _num(spec, "keep_apart_m", GAP_M, "", 0.0, 5.0),
-               bounds={w.person_id: area for w in crowd}, obstacles=world.circles, visitors=visitors)
+               bounds={w.person_id: area for w in crowd}, obstacles=world.circles, visitors=visitors,
+               robot=_robot_base_path(make_driver(), start, duration) if radius > 0 else None,
+               robot_radius_m=radius)
     sim = Simulation(laser, world, walkers, rng, mount=mount, start=start, driver=driver,
                      odom_trans_noise=_num(noise, "trans", 0.0, "robot.odometry_noise.", 0.0, 1.0),
                      odom_rot_noise=_num(noise, "rot", 0.0, "robot.odometry_noise.", 0.0, 1.0),
                      has_odometry=bool(robot.get("odometry", True)), target_id=target_id)
     return sim, int(round(duration * laser.rate_hz))
+
+
+def _driver_factory(robot: dict, walkers: list[Walker], target_id: int | None):
+    """A function that builds the robot's driver afresh (drivers keep state: a trail, a
+    waypoint reached), or returns None when the robot stands still."""
+    if target_id is not None:
+        f = robot["follow"]
+        target = next(w for w in walkers if w.person_id == target_id)
+        distance = _num(f, "distance", 1.0, "robot.follow.", 0.1, 20.0)
+        max_speed = _num(f, "max_speed", 1.2, "robot.follow.", 0.0, 5.0)
+        max_turn = (math.radians(_num(f, "max_turn_degps", 1.0, "robot.follow.", 1.0, 1000.0))
+                    if "max_turn_degps" in f else 1.5)
+        trail, hold, beside = bool(f.get("trail", False)), _hold(f.get("hold")), _beside(f.get("beside"))
+        return lambda: FollowDriver(lambda t, w=target: w.torso(t) if w.present(t) else None, distance,
+                                    max_speed, max_turn, trail, hold, beside)
+    if "drive" in robot:
+        try:
+            pieces = [(float(d), float(v), math.radians(float(w))) for d, v, w in robot["drive"]]
+        except (TypeError, ValueError):
+            raise ScenarioError("scenario key 'robot.drive' must be a list of [duration_s, v_mps, omega_degps]") from None
+        return lambda: ScriptedDriver(pieces)
+    if "waypoints" in robot:
+        speed = _num(robot, "speed", 0.8, "robot.", 0.0, 5.0)
+        max_turn = math.radians(_num(robot, "max_turn_degps", 60.0, "robot.", 0.0, 1000.0))
+        return lambda: WaypointDriver(robot["waypoints"], speed, max_turn)
+    return lambda: None
+
+
+def _robot_base_path(driver, start: Pose2D, duration_s: float, steps_hz: float = 50.0):
+    """Where the robot's base will be (m, world frame), as a function of an array of times (s):
+    ``driver`` run from ``start`` for ``duration_s``, asked ``steps_hz`` times a second. The
+    drivers steer by time and by the people's scripted paths (a followed person never steps
+    aside), not by anyone who makes way, so the path is known before the scene is built. The
+    simulation asks its driver at 200 Hz; at 50 Hz the path stays within 4 cm of it over
+    ``follow_indoor_crowd``'s 10 minutes, at a quarter of the cost (ad hoc, 2026-11-28)."""
+    if driver is None:
+        return lambda times: np.tile([start.x, start.y], (len(times), 1))
+    dt = 1.0 / steps_hz
+    steps = int(math.ceil(duration_s * steps_hz)) + 1
+    xy = np.empty((steps + 1, 2))
+    pose = start
+    xy[0] = pose.x, pose.y
+    for k in range(steps):
+        pose = integrate(pose, driver(k * dt, pose), dt)
+        xy[k + 1] = pose.x, pose.y
+    at = np.arange(steps + 1) * dt
+    return lambda times: np.column_stack([np.interp(times, at, xy[:, 0]), np.interp(times, at, xy[:, 1])])
 
 
 def _as_list(section) -> list:

@@ -90,10 +90,12 @@ def test_people_step_aside_rather_than_walk_through_each_other(name, seconds):
     assert close[0.30] > 5.0, close  # without it people overlap for seconds
     # with it hardly ever: a walker squeezed between several, or by the crowd's edge, may still be
     assert apart[0.30] < 0.1 * close[0.30] and apart[0.40] < 0.1 * close[0.40], (apart, close)
-    if name == "follow_indoor_crowd":  # and never through the followed person
+    if name == "follow_indoor_crowd":  # and never through the followed person (someone crossing
+        # in the metre between them and the robot that follows them, which they walk round too,
+        # may be squeezed to a little under 0.3 m for a moment)
         person = next(w for w in sim.walkers if w.person_id == sim.target_id)
         others = [w for w in sim.walkers if w is not person]
-        assert all(np.hypot(*(w.torso(t) - person.torso(t))) >= 0.30
+        assert all(np.hypot(*(w.torso(t) - person.torso(t))) >= 0.25
                    for w in others for t in times if w.present(t))
     # only a step aside: everyone stays within a metre of their path, in the crowd's area
     for w in sim.walkers:
@@ -156,3 +158,28 @@ def test_the_paths_worked_out_at_once_are_the_walkers_own():
         pos, _, present = w.path_positions(times)
         assert np.allclose(pos, [w.torso(t) for t in times], atol=1e-9)
         assert list(present) == [w.present(t) for t in times]
+
+
+def _robot_clearance(spec: dict, laser: str) -> tuple[float, float]:
+    """Seconds someone's torso spends within 0.4 m of the robot's base (inside its 0.3 m
+    footprint, give or take a leg) while the scene runs, and the closest any comes (m)."""
+    sim, n = build_simulation(spec, laser=laser)
+    seconds, closest = 0.0, np.inf
+    for _ in range(n):
+        truth = sim.step().truth
+        base = np.array([truth.robot_pose.x, truth.robot_pose.y])
+        d = np.hypot(*(truth.torso_world - base).T)
+        seconds += float((d < 0.4).sum()) * sim.laser.period
+        closest = min(closest, float(d.min(initial=np.inf)))
+    return seconds, closest
+
+
+def test_people_walk_round_the_robot():
+    # the robot drives after the person through the corridor's crowd; people make way for it
+    # as for a pillar that moves (robot.radius_m), its path worked out before the scene runs
+    spec = {**load_scenario("follow_indoor_crowd"), "duration_s": 90}
+    through = {**spec, "robot": {**spec["robot"], "radius_m": 0.0}}
+    before, deepest = _robot_clearance(through, "narrow")
+    after, closest = _robot_clearance(spec, "narrow")
+    assert before > 1.0 and deepest < 0.2, (before, deepest)  # without it they walk through the robot
+    assert after == 0.0 and closest > 0.4, (after, closest)
