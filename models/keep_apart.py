@@ -63,15 +63,14 @@ def keep_apart(fixed: list[Walker], yielding: list[Walker], duration_s: float, g
     there[:len(obstacles)] = True
     gaps[:len(obstacles)] = obstacles[:, 2] + 0.5 * gap_m
     m = len(obstacles)
-    if robot is not None:  # a round obstacle that drives
-        where = np.asarray(robot(times), dtype=float).reshape(len(times), 2)
-        pos[m], there[m], gaps[m] = where, True, robot_radius_m + 0.5 * gap_m
-        vel[m] = np.gradient(where, dt_s, axis=0) if len(times) > 1 else 0.0
-        m += 1
 
-    def place(row: int, where: np.ndarray, present: np.ndarray) -> None:
-        pos[row], there[row], gaps[row] = where, present, gap_m
+    def place(row: int, where: np.ndarray, present: np.ndarray, gap: float = gap_m) -> None:
+        pos[row], there[row], gaps[row] = where, present, gap
         vel[row] = np.gradient(where, dt_s, axis=0) if len(times) > 1 else 0.0
+
+    if robot is not None:  # a round obstacle that drives
+        place(m, np.asarray(robot(times), dtype=float).reshape(len(times), 2), True, robot_radius_m + 0.5 * gap_m)
+        m += 1
 
     def detour(w: Walker, base: np.ndarray, heading: np.ndarray, present: np.ndarray, upto: int,
                hold_when_still: bool = False) -> np.ndarray:

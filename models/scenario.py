@@ -528,19 +528,23 @@ def _robot_base_path(driver, start: Pose2D, duration_s: float, steps_hz: float =
     drivers steer by time and by the people's scripted paths (a followed person never steps
     aside), not by anyone who makes way, so the path is known before the scene is built. The
     simulation asks its driver at 200 Hz; at 50 Hz the path stays within 4 cm of it over
-    ``follow_indoor_crowd``'s 10 minutes, at a quarter of the cost (ad hoc, 2026-11-28)."""
-    if driver is None:
-        return lambda times: np.tile([start.x, start.y], (len(times), 1))
-    dt = 1.0 / steps_hz
-    steps = int(math.ceil(duration_s * steps_hz)) + 1
-    xy = np.empty((steps + 1, 2))
-    pose = start
-    xy[0] = pose.x, pose.y
-    for k in range(steps):
-        pose = integrate(pose, driver(k * dt, pose), dt)
-        xy[k + 1] = pose.x, pose.y
-    at = np.arange(steps + 1) * dt
-    return lambda times: np.column_stack([np.interp(times, at, xy[:, 0]), np.interp(times, at, xy[:, 1])])
+    ``follow_indoor_crowd``'s 10 minutes, at a quarter of the cost (ad hoc, 2026-11-28). The
+    driver runs when the function is called: a scene where nobody makes way never asks."""
+    def at_times(times: np.ndarray) -> np.ndarray:
+        if driver is None:
+            return np.tile([start.x, start.y], (len(times), 1))
+        dt = 1.0 / steps_hz
+        steps = int(math.ceil(duration_s * steps_hz)) + 1
+        xy = np.empty((steps + 1, 2))
+        pose = start
+        xy[0] = pose.x, pose.y
+        for k in range(steps):
+            pose = integrate(pose, driver(k * dt, pose), dt)
+            xy[k + 1] = pose.x, pose.y
+        at = np.arange(steps + 1) * dt
+        return np.column_stack([np.interp(times, at, xy[:, 0]), np.interp(times, at, xy[:, 1])])
+
+    return at_times
 
 
 def _as_list(section) -> list:
