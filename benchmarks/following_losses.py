@@ -11,7 +11,9 @@ track is on them (the tracker has them, the target model gave the id to no one: 
 less than ``relock_s``, or after it, how many reported tracks lay where the re-lock looks
 for the person, the zone ahead and beyond it where they could be: with two or more the id
 goes to none, and one that walks as the person could not takes no id either);
-no target while only an unreported track is on them; no target and no track near them.
+no target while the person's track coasts (no update for the selector's ``coast_s``: it
+is reported as a track, but not marked as the target); no target while only an unreported
+track is on them; no target and no track near them.
 The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
 """
 
@@ -49,8 +51,11 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
         if target is not None:
             out["target on the person" if dist[target] <= NEAR_M else "target on someone or something else"] += 1
             continue
-        if any(d <= NEAR_M for d in dist.values()):
-            stamp = record.scan.stamp
+        stamp = record.scan.stamp
+        if sel.target is not None and sel.lost_since is None and any(
+                u.track_id == sel.target and stamp - u.last_update >= sel.coast_s for u in tracker._tracks):
+            out[f"no target: the person's track has had no update for {sel.coast_s:g} s (reported lost)"] += 1
+        elif any(d <= NEAR_M for d in dist.values()):
             if sel.target is None or sel.lost_since is None:
                 why = "no person being looked for (given up, and they are not ahead)"
             elif stamp - sel.lost_since < sel.relock_s:

@@ -968,7 +968,11 @@ class PeopleTracker:
 
     def _follow(self, world: Pose2D, stamp: float, unreported: list[TrackState] = ()) -> int | None:
         """The followed person's track id (see :mod:`people_tracker.tracker.following`);
-        the tracks of ``unreported`` are not offered to it."""
+        the tracks of ``unreported`` are not offered to it. None while the target's track has
+        had no update for the selector's ``coast_s`` (s): the selector keeps the id, but a
+        prediction carried on that long is a guess, most often off the person by the time they
+        are seen again (a turn out of view, a passer-by between), so the person is reported
+        lost rather than somewhere they are not."""
         sel = self.selector
         if sel is None:
             return None
@@ -1003,12 +1007,20 @@ class PeopleTracker:
                 others = [u for u in self._tracks if u.track_id != sel.target and u.reported and u not in unreported]
                 new_id = sel.reacquire(stamp, here(others), {u.track_id: u.velocity for u in others})
                 if new_id is not None:
+                    for u in self._tracks:  # the id's old track, if it lives on unreported, is not them
+                        if u.track_id == sel.target:
+                            self._retire(u)
                     new = next(u for u in self._tracks if u.track_id == new_id)
                     new.track_id = sel.target  # the person keeps their id
         reported = here(u for u in self._tracks if u.reported and u not in unreported)
         target = sel.choose(reported)
         if target is not None and sel.expected(stamp) is None and target in reported:
             sel.seen(stamp, reported[target], next(u.velocity for u in self._tracks if u.track_id == target))
+        # (an unreported track the id was taken from may still carry it: only the reported ones count)
+        unseen = [stamp - u.last_update for u in self._tracks
+                  if u.track_id == target and u.reported and u not in unreported]
+        if unseen and min(unseen) >= sel.coast_s:
+            return None  # coasting: where the person is now is a guess; reported lost, not marked
         return target
 
     def _retire(self, t: TrackState) -> None:
