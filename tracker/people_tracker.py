@@ -1014,12 +1014,10 @@ class PeopleTracker:
                     new.track_id = sel.target  # the person keeps their id
         reported = here(u for u in self._tracks if u.reported and u not in unreported)
         target = sel.choose(reported)
-        if target is not None and sel.expected(stamp) is None and target in reported:
-            sel.seen(stamp, reported[target], next(u.velocity for u in self._tracks if u.track_id == target))
-        # (an unreported track the id was taken from may still carry it: only the reported ones count)
-        unseen = [stamp - u.last_update for u in self._tracks
-                  if u.track_id == target and u.reported and u not in unreported]
-        if unseen and min(unseen) >= sel.coast_s:
+        t = next(u for u in self._tracks if u.track_id == target) if target in reported else None  # ids are unique
+        if t is not None and sel.expected(stamp) is None:
+            sel.seen(stamp, reported[target], t.velocity)
+        if t is not None and stamp - t.last_update >= sel.coast_s:
             return None  # coasting: where the person is now is a guess; reported lost, not marked
         return target
 
