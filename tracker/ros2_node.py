@@ -13,7 +13,8 @@ executor is never blocked; when tracking falls behind, the oldest queued scans a
 publishes ``people`` (``geometry_msgs/PoseArray`` in the fixed frame, heading along the
 velocity), ``people_markers`` (``visualization_msgs/MarkerArray``: position, id, 2σ
 ellipse, velocity arrow, the target highlighted; markers of ended tracks deleted),
-``people_target`` (``geometry_msgs/PoseStamped``, while a target is locked) and, when
+``people_target`` (``geometry_msgs/PoseStamped``, while a target is locked and its track is
+updated: not while it coasts) and, when
 asked, ``legs`` (``PoseArray``, leg candidates the leg model finds likely).
 """
 
