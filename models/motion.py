@@ -9,6 +9,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from people_tracker.models import compiled
+
 # H: a person candidate measures position only
 H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
 
@@ -43,3 +45,107 @@ def constant_velocity_Q(dt: float, accel_var: float) -> np.ndarray:
     """
     q = np.array([[0.25 * dt ** 4, 0.5 * dt ** 3], [0.5 * dt ** 3, dt ** 2]])
     return np.kron(np.eye(2), q) * accel_var
+
+
+
+# The track filter's two steps written out for the model above (state [x, vx, y, vy], H
+# measuring x and y): filterpy's ``KalmanFilter.predict`` and ``update`` do the same
+# arithmetic through a dozen small matrix products, an inverse and a deep copy (about 3
+# and 11 microseconds a call), where the work is a few dozen multiplications. Each step is
+# numpy code on whole rows and columns, and a compiled kernel (numba, the ``[fast]``
+# extra) doing the same operations in the same order, element by element, so the two
+# agree to the bit (``tests/detection/test_compiled.py``); both equal filterpy's to 1e-9
+# (``tests/tracker/test_motion.py``: filterpy multiplies whole matrices and inverts by LU,
+# so the last bits differ). The filter's state stays in a filterpy ``KalmanFilter``, whose
+# ``x`` and ``P`` are replaced, not written into, as filterpy does.
+
+def cv_predict(x: np.ndarray, P: np.ndarray, dt: float, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The constant-velocity prediction over ``dt`` seconds: x = F x; P = F P Fᵀ + Q, with
+    F = :func:`constant_velocity_F` (``dt``) and ``Q`` its process noise (m², m²/s, m²/s²).
+    Returns new arrays."""
+    if compiled.on:
+        return _predict_kernel(x, P, float(dt), Q)
+    # x = F x: each position moves by its velocity times dt
+    xn = x.copy()
+    xn[0::2] = x[0::2] + dt * x[1::2]
+    # F P: the position rows gain dt times the velocity rows
+    FP = P.copy()
+    FP[0::2] = P[0::2] + dt * P[1::2]
+    # (F P) Fᵀ: the position columns gain dt times the velocity columns; then + Q
+    M = FP.copy()
+    M[:, 0::2] = FP[:, 0::2] + dt * FP[:, 1::2]
+    return xn, M + Q
+
+
+def _predict_loop(x, P, dt, Q):
+    """:func:`cv_predict`'s numpy code, element by element (compiled by numba)."""
+    xn = x.copy()
+    for i in (0, 2):
+        xn[i] = x[i] + dt * x[i + 1]
+    FP = P.copy()
+    for i in (0, 2):
+        for j in range(4):
+            FP[i, j] = P[i, j] + dt * P[i + 1, j]
+    Pn = np.empty((4, 4))
+    for i in range(4):
+        for j in range(4):
+            m = FP[i, j] + dt * FP[i, j + 1] if j % 2 == 0 else FP[i, j]
+            Pn[i, j] = m + Q[i, j]
+    return xn, Pn
+
+
+def position_update(x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The update with a measured position ``z`` (x, y; m) of covariance ``R`` (2, 2; m²),
+    H = :data:`H`: y = z - H x; S = H P Hᵀ + R; K = P Hᵀ S⁻¹; x = x + K y; and the
+    covariance in Joseph's form, as filterpy keeps it, P = (I - K H) P (I - K H)ᵀ + K R Kᵀ.
+    Returns new arrays."""
+    if compiled.on:
+        return _update_kernel(x, P, z, R)
+    # S = H P Hᵀ + R (H picks rows and columns 0 and 2), and its inverse written out
+    s00, s01, s10, s11 = P[0, 0] + R[0, 0], P[0, 2] + R[0, 1], P[2, 0] + R[1, 0], P[2, 2] + R[1, 1]
+    det = s00 * s11 - s01 * s10
+    i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
+    # K = P Hᵀ S⁻¹
+    k0 = P[:, 0] * i00 + P[:, 2] * i10
+    k1 = P[:, 0] * i01 + P[:, 2] * i11
+    # x = x + K (z - H x)
+    y0, y1 = z[0] - x[0], z[1] - x[2]
+    xn = x + (k0 * y0 + k1 * y1)
+    # A P, with A = I - K H: each row i loses K[i] times P's rows 0 and 2
+    AP = P - k0[:, None] * P[0] - k1[:, None] * P[2]
+    # (A P) Aᵀ: each column j loses K[j] times (A P)'s columns 0 and 2
+    APA = AP - AP[:, 0:1] * k0 - AP[:, 2:3] * k1
+    # + K R Kᵀ
+    kr0 = k0 * R[0, 0] + k1 * R[1, 0]
+    kr1 = k0 * R[0, 1] + k1 * R[1, 1]
+    return xn, APA + (kr0[:, None] * k0 + kr1[:, None] * k1)
+
+
+def _update_loop(x, P, z, R):
+    """:func:`position_update`'s numpy code, element by element (compiled by numba)."""
+    s00, s01, s10, s11 = P[0, 0] + R[0, 0], P[0, 2] + R[0, 1], P[2, 0] + R[1, 0], P[2, 2] + R[1, 1]
+    det = s00 * s11 - s01 * s10
+    i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
+    k0, k1 = np.empty(4), np.empty(4)
+    for i in range(4):
+        k0[i] = P[i, 0] * i00 + P[i, 2] * i10
+        k1[i] = P[i, 0] * i01 + P[i, 2] * i11
+    y0, y1 = z[0] - x[0], z[1] - x[2]
+    xn = np.empty(4)
+    for i in range(4):
+        xn[i] = x[i] + (k0[i] * y0 + k1[i] * y1)
+    AP = np.empty((4, 4))
+    for i in range(4):
+        for j in range(4):
+            AP[i, j] = P[i, j] - k0[i] * P[0, j] - k1[i] * P[2, j]
+    Pn = np.empty((4, 4))
+    for i in range(4):
+        kr0 = k0[i] * R[0, 0] + k1[i] * R[1, 0]
+        kr1 = k0[i] * R[0, 1] + k1[i] * R[1, 1]
+        for j in range(4):
+            Pn[i, j] = (AP[i, j] - AP[i, 0] * k0[j] - AP[i, 2] * k1[j]) + (kr0 * k0[j] + kr1 * k1[j])
+    return xn, Pn
+
+
+_predict_kernel = compiled.njit(_predict_loop)
+_update_kernel = compiled.njit(_update_loop)

@@ -10,7 +10,7 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 from people_tracker.detection.free_space import UNSEEN
-from people_tracker.models.motion import H, constant_velocity_FQ
+from people_tracker.models.motion import H, constant_velocity_FQ, cv_predict, position_update
 from people_tracker.tracker.existence import Existence, logit
 
 
@@ -143,8 +143,8 @@ class TrackState:
                 self.kf.P[2, 2] += d
             else:
                 F, Q = constant_velocity_FQ(dt, self.params.accel_std_mps2 ** 2)
-                # x = F x ;  P = F P Fᵀ + Q
-                self.kf.predict(F=F, Q=Q)
+                # x = F x ;  P = F P Fᵀ + Q  (F's dt as the shared F and Q round it)
+                self.kf.x, self.kf.P = cv_predict(self.kf.x, self.kf.P, float(F[0, 1]), Q)
             self.stamp = stamp
         self.update_kind = None
 
@@ -159,8 +159,9 @@ class TrackState:
 
     def update(self, z: np.ndarray, R: np.ndarray, moving: bool) -> None:
         """Correct with a candidate position ``z`` (m) of covariance ``R`` (m²)."""
-        # y = z - H x ; S = H P Hᵀ + R ; K = P Hᵀ S⁻¹ ; x = x + K y ; P = (I - K H) P
-        self.kf.update(z, R=R)
+        # y = z - H x ; S = H P Hᵀ + R ; K = P Hᵀ S⁻¹ ; x = x + K y ; P = (I - K H) P (I - K H)ᵀ + K R Kᵀ
+        self.kf.x, self.kf.P = position_update(self.kf.x, self.kf.P, np.asarray(z, dtype=float),
+                                               np.asarray(R, dtype=float))
         self.last_update = self.stamp
         self.seen_position = self.position.copy()
         self.hidden_position = None

@@ -352,3 +352,30 @@ def test_the_warm_up_reaches_every_kernel():
             "print(len(compiled.KERNELS), [k.py_func.__qualname__ for k in compiled.KERNELS if not k.signatures])\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split(" ", 1)
     assert int(out[0]) >= 8 and out[1].strip() == "[]", out
+
+
+def test_track_filter_steps_agree():
+    """The track filter's predict and update (the state and its covariance) to the bit, over
+    long runs of random steps, steps of zero and tiny measurement noise included."""
+    from people_tracker.models.motion import constant_velocity_Q, cv_predict, position_update
+    rng = np.random.default_rng(14)
+    for k in range(300):
+        x = rng.normal(0, [5, 1.5, 5, 1.5])
+        A = rng.normal(size=(4, 4)) * 10.0 ** rng.uniform(-3, 0.5, 4)
+        P = A @ A.T + np.diag(10.0 ** rng.uniform(-6, 0, 4))
+        for step in range(20):
+            dt = float(rng.choice([0.0, 0.0133, 0.0667, 0.1, 0.45, 2.0]))
+            Q = constant_velocity_Q(dt, float(rng.uniform(0.1, 4.0)))
+            fast = cv_predict(x, P, dt, Q)
+            with compiled.numpy_only():
+                ref = cv_predict(x, P, dt, Q)
+            assert all(a.tobytes() == b.tobytes() for a, b in zip(fast, ref)), f"predict {k}.{step}"
+            x, P = ref
+            z = x[::2] + rng.normal(0, 0.3, 2)
+            c = rng.uniform(-0.5, 0.5) * 1e-3
+            R = np.array([[rng.uniform(1e-6, 0.05), c], [c, rng.uniform(1e-6, 0.05)]])
+            fast = position_update(x, P, z, R)
+            with compiled.numpy_only():
+                ref = position_update(x, P, z, R)
+            assert all(a.tobytes() == b.tobytes() for a, b in zip(fast, ref)), f"update {k}.{step}"
+            x, P = ref
