@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
-from scipy.linalg.lapack import dsyev
 
-from people_tracker.detection.kdtree import PointTree
+from people_tracker.detection.kdtree import PointTree, grid_query_kernel as _grid_kernel
 from people_tracker.models import compiled
-from people_tracker.models.compiled import njit
-from people_tracker.models.pose import Pose2D, rotate_translate, wrap_angle
+from people_tracker.models.compiled import njit, reduceat_sum
+from people_tracker.models.pose import Pose2D, rotate_translate, transform_kernel as _transform_kernel, wrap_angle
 
 
 @dataclass(frozen=True)
@@ -152,6 +152,14 @@ class ReferenceScan:
         self._set_usable(self.usable & ~mask)
 
 
+@lru_cache(maxsize=64)
+def _spread(n: int, m: int) -> np.ndarray:
+    """``m`` indices evenly spread over ``n`` readings (read-only, shared)."""
+    index = np.linspace(0, n - 1, m).round().astype(np.int64)
+    index.setflags(write=False)
+    return index
+
+
 def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: IcpParams,
           exclude: np.ndarray | None = None) -> MatchResult:
     """Point-to-line ICP of ``current`` readings onto ``reference``.
@@ -175,7 +183,7 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
     if params.max_source_points and len(src) > params.max_source_points:
         # evenly spread readings constrain the pose as well as all of them do, at a fraction
         # of the cost of the nearest-neighbour queries
-        src = src[np.linspace(0, len(src) - 1, params.max_source_points).round().astype(np.int64)]
+        src = src[_spread(len(src), params.max_source_points)]
     n_src = len(src)
 
     def fail(reason: str, rms=math.nan, overlap=0.0, cond=0.0, it=0) -> MatchResult:
@@ -183,60 +191,17 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
 
     if reference.tree is None or reference.n_usable < params.min_pairs or n_src < params.min_pairs:
         return fail("too few readings")
-    x, y, th = prior.x, prior.y, prior.yaw
-    gate = params.max_correspondence_m
-    cond = 0.0
-    degenerate = False
-    rms = math.nan
-    overlap = 0.0
-    it = 0
-    for it in range(1, params.max_iterations + 1):
-        c, s = math.cos(th), math.sin(th)
-        p = rotate_translate(src, c, s, x, y)  # R p + t, in the reference frame
-        _, j = reference.tree.query(p, gate)
-        if compiled.on:  # the pairs, their trimming and the Jacobian as one compiled loop
-            n_found, p, r, A = _pairs_kernel(p, j, reference.usable_or_none, reference.points, reference.normals,
-                                             params.trim_fraction)
-            if n_found < params.min_pairs:
-                return fail("too few correspondences", it=it)
-        else:
-            found = reference.usable_or_none[j]  # none within the gate, or a partner without a normal: no line
-            if np.count_nonzero(found) < params.min_pairs:
-                return fail("too few correspondences", it=it)
-            j = j[found]
-            p, q, nq = p[found], reference.points[j], reference.normals[j]
-            r = np.einsum("ij,ij->i", p - q, nq)  # point-to-line residual
-            # trimmed: keep the best share of the pairs (a partition, not a sort)
-            absr = np.abs(r)
-            k = int(params.trim_fraction * (len(absr) - 1))
-            keep = absr <= np.partition(absr, k)[k]
-            p, nq, r = p[keep], nq[keep], r[keep]
-            # Jacobian of n·(R(dθ) p + d - q) at zero: [n_x, n_y, n·(J p)], J p = (-p_y, p_x)
-            A = np.empty((len(r), 3))
-            A[:, :2] = nq
-            A[:, 2] = nq[:, 1] * p[:, 0] - nq[:, 0] * p[:, 1]
-        Hm = A.T @ A
-        g = A.T @ r
-        # the rotation column measured in metres at the scene's typical range, for a fair comparison
-        scale = max(math.sqrt(float(np.einsum("ij,ij->", p, p)) / len(p)), 1.0)
-        d = np.array([1.0, 1.0, 1.0 / scale])  # D = diag(d)
-        w, V, _ = dsyev(Hm * np.outer(d, d))  # eigen-decomposition of D H D (LAPACK, no wrapper)
-        cond = float(w[0] / w[-1]) if w[-1] > 0 else 0.0
-        # solve in the scaled space, dropping directions the scene does not constrain
-        good = w > params.degeneracy_ratio * w[-1]
-        degenerate = bool((~good).any())
-        Vg = V[:, good]
-        step_scaled = -(Vg @ ((Vg.T @ (d * g)) / w[good]))
-        dx, dy, dth = (d * step_scaled).tolist()
-        # compose the increment on the left: T ← ΔT ∘ T
-        cd, sd = math.cos(dth), math.sin(dth)
-        x, y = cd * x - sd * y + dx, sd * x + cd * y + dy
-        th = float(wrap_angle(th + dth))
-        rms = math.sqrt(float(r @ r) / len(r))
-        overlap = float(len(r) / n_src)  # the pairs kept
-        gate = max(params.min_correspondence_m, gate * 0.5)
-        if it >= 2 and abs(dx) < 2e-3 and abs(dy) < 2e-3 and abs(dth) < 2e-4:
-            break  # settled: a further step would move a reading less than 1 mm (at 10 m)
+    grid = reference.tree.grid
+    if compiled.on and grid is not None:  # the whole loop below as one compiled call
+        paired, x, y, th, it, rms, overlap, cond, degenerate = _icp_kernel(
+            np.ascontiguousarray(src, dtype=np.float64), float(prior.x), float(prior.y), float(prior.yaw), *grid,
+            reference.usable_or_none, reference.points, reference.normals, params.max_iterations,
+            params.max_correspondence_m, params.min_correspondence_m, params.trim_fraction, params.min_pairs,
+            params.degeneracy_ratio)
+    else:
+        paired, x, y, th, it, rms, overlap, cond, degenerate = _icp_numpy(src, reference, prior, params)
+    if not paired:
+        return fail("too few correspondences", it=it)
     result = Pose2D(x, y, th)
     correction = prior.between(result)
     if overlap < params.min_overlap:
@@ -245,11 +210,155 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         return fail(f"residual {rms:.3f} m above {params.max_rms_m} m", rms, overlap, cond, it)
     if math.hypot(correction.x, correction.y) > params.max_correction_m or abs(correction.yaw) > params.max_correction_rad:
         return fail("result too far from the prior", rms, overlap, cond, it)
-    return MatchResult(result, True, rms, overlap, cond, degenerate, it)
+    return MatchResult(result, True, rms, overlap, cond, bool(degenerate), it)
+
+
+# The sums of one iteration, per kept pair: the normal equations' six distinct entries
+# (AᵀA, A's columns a0 a1 a2: a0a0 a0a1 a0a2 a1a1 a1a2 a2a2), Aᵀr (three), the squared
+# distance of the reading from the sensor and the squared residual. Both paths add each
+# column in the order np.add.reduceat adds (compiled.reduceat_sum), so they agree to the bit.
+_N_SUMS = 11
+
+
+def _icp_numpy(src, reference: ReferenceScan, prior: Pose2D, params: IcpParams):
+    """The ICP iterations in numpy (the reference for :func:`_icp_loop`): whether enough
+    pairs were found every iteration, the pose (x, y, yaw), the iterations run, the inlier
+    RMS (m), the overlap, the conditioning and whether a direction was degenerate."""
+    x, y, th = float(prior.x), float(prior.y), float(prior.yaw)
+    gate = params.max_correspondence_m
+    cond, degenerate, rms, overlap, it = 0.0, False, math.nan, 0.0, 0
+    for it in range(1, params.max_iterations + 1):
+        c, s = math.cos(th), math.sin(th)
+        p = rotate_translate(src, c, s, x, y)  # R p + t, in the reference frame
+        _, j = reference.tree.query(p, gate)
+        found = reference.usable_or_none[j]  # none within the gate, or a partner without a normal: no line
+        if np.count_nonzero(found) < params.min_pairs:
+            return False, x, y, th, it, rms, overlap, cond, degenerate
+        j = j[found]
+        p, q, nq = p[found], reference.points[j], reference.normals[j]
+        # point-to-line residual (from +0.0, as einsum's dot product)
+        r = 0.0 + (p[:, 0] - q[:, 0]) * nq[:, 0] + (p[:, 1] - q[:, 1]) * nq[:, 1]
+        # trimmed: keep the best share of the pairs (a partition, not a sort)
+        absr = np.abs(r)
+        k = int(params.trim_fraction * (len(absr) - 1))
+        keep = absr <= np.partition(absr, k)[k]
+        p, nq, r = p[keep], nq[keep], r[keep]
+        # Jacobian of n·(R(dθ) p + d - q) at zero: [n_x, n_y, n·(J p)], J p = (-p_y, p_x)
+        a0, a1, a2 = nq[:, 0], nq[:, 1], nq[:, 1] * p[:, 0] - nq[:, 0] * p[:, 1]
+        terms = np.column_stack([a0 * a0, a0 * a1, a0 * a2, a1 * a1, a1 * a2, a2 * a2, a0 * r, a1 * r, a2 * r,
+                                 p[:, 0] * p[:, 0] + p[:, 1] * p[:, 1], r * r])
+        sums = np.add.reduceat(terms, [0], axis=0)[0]
+        dx, dy, dth, cond, degenerate = _solve_step(*sums[:9], math.sqrt(sums[9] / len(r)), params.degeneracy_ratio)
+        # compose the increment on the left: T ← ΔT ∘ T
+        cd, sd = math.cos(dth), math.sin(dth)
+        x, y = cd * x - sd * y + dx, sd * x + cd * y + dy
+        th = wrap_angle(th + dth)
+        rms = math.sqrt(sums[10] / len(r))
+        overlap = len(r) / len(src)  # the pairs kept
+        gate = max(params.min_correspondence_m, gate * 0.5)
+        if it >= 2 and abs(dx) < 2e-3 and abs(dy) < 2e-3 and abs(dth) < 2e-4:
+            break  # settled: a further step would move a reading less than 1 mm (at 10 m)
+    return True, x, y, th, it, rms, overlap, cond, degenerate
+
+
+def _icp_loop(src, x, y, th, tree_points, geometry, shape, start, order, usable_or_none, ref_points, ref_normals,
+              max_iterations, max_gate, min_gate, trim_fraction, min_pairs, degeneracy_ratio):
+    """:func:`_icp_numpy` as one loop (compiled by numba): the same operations in the same order."""
+    gate = max_gate
+    cond, degenerate, rms, overlap, it = 0.0, False, np.nan, 0.0, 0
+    sums = np.empty(_N_SUMS)
+    for it in range(1, max_iterations + 1):
+        c, s = math.cos(th), math.sin(th)
+        p = _transform_kernel(src, c, s, x, y)
+        _, j = _grid_kernel(tree_points, geometry, shape, start, order, p, gate)
+        n_found, p, r, A = _pairs_kernel(p, j, usable_or_none, ref_points, ref_normals, trim_fraction)
+        if n_found < min_pairs:
+            return False, x, y, th, it, rms, overlap, cond, degenerate
+        m = len(r)
+        terms = np.empty((_N_SUMS, m))
+        for i in range(m):
+            a0, a1, a2, ri = A[i, 0], A[i, 1], A[i, 2], r[i]
+            terms[0, i], terms[1, i], terms[2, i] = a0 * a0, a0 * a1, a0 * a2
+            terms[3, i], terms[4, i], terms[5, i] = a1 * a1, a1 * a2, a2 * a2
+            terms[6, i], terms[7, i], terms[8, i] = a0 * ri, a1 * ri, a2 * ri
+            terms[9, i], terms[10, i] = p[i, 0] * p[i, 0] + p[i, 1] * p[i, 1], ri * ri
+        for k in range(_N_SUMS):
+            sums[k] = reduceat_sum(terms[k])
+        dx, dy, dth, cond, degenerate = _solve_step(sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6],
+                                                    sums[7], sums[8], math.sqrt(sums[9] / m), degeneracy_ratio)
+        cd, sd = math.cos(dth), math.sin(dth)
+        x, y = cd * x - sd * y + dx, sd * x + cd * y + dy
+        th = (th + dth + math.pi) % (2.0 * math.pi) - math.pi  # wrap_angle's arithmetic
+        rms = math.sqrt(sums[10] / m)
+        overlap = m / len(src)
+        gate = max(min_gate, gate * 0.5)
+        if it >= 2 and abs(dx) < 2e-3 and abs(dy) < 2e-3 and abs(dth) < 2e-4:
+            break
+    return True, x, y, th, it, rms, overlap, cond, degenerate
+
+
+def _solve_step(h00, h01, h02, h11, h12, h22, g0, g1, g2, rms_range, degeneracy_ratio):
+    """One Gauss-Newton step from the normal equations H δ = -g (H = AᵀA given by its six
+    distinct entries, g = Aᵀr), δ = (dx, dy, dθ): the rotation column measured in metres at
+    the scene's typical range (``rms_range``, at least 1 m) for a fair comparison, directions
+    the scene does not constrain (eigenvalue below ``degeneracy_ratio`` of the largest) left
+    out. Returns dx, dy, dθ, the conditioning (smallest over largest eigenvalue) and whether
+    a direction was left out. Plain arithmetic (a cyclic Jacobi eigen-decomposition of the
+    3x3 matrix), the same from Python and compiled."""
+    d2 = 1.0 / max(rms_range, 1.0)  # D = diag(1, 1, d2)
+    # M = D H D
+    a = [[h00, h01, h02 * d2], [h01, h11, h12 * d2], [h02 * d2, h12 * d2, h22 * d2 * d2]]
+    v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    for _sweep in range(32):
+        off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2]
+        diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2]
+        if not off > 1e-32 * diag:
+            break
+        for pq in range(3):
+            pi_, qi = (0, 1) if pq == 0 else ((0, 2) if pq == 1 else (1, 2))
+            apq = a[pi_][qi]
+            if apq == 0.0:
+                continue
+            # the rotation that zeroes a[p][q]: t = tan of its angle, the smaller root
+            theta = (a[qi][qi] - a[pi_][pi_]) / (2.0 * apq)
+            t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
+            if theta < 0.0:
+                t = -t
+            c = 1.0 / math.sqrt(t * t + 1.0)
+            s = t * c
+            for k in range(3):  # M ← M J (columns p and q)
+                akp, akq = a[k][pi_], a[k][qi]
+                a[k][pi_], a[k][qi] = c * akp - s * akq, s * akp + c * akq
+            for k in range(3):  # M ← Jᵀ M (rows p and q)
+                apk, aqk = a[pi_][k], a[qi][k]
+                a[pi_][k], a[qi][k] = c * apk - s * aqk, s * apk + c * aqk
+            for k in range(3):  # V ← V J
+                vkp, vkq = v[k][pi_], v[k][qi]
+                v[k][pi_], v[k][qi] = c * vkp - s * vkq, s * vkp + c * vkq
+    # eigenvalues in ascending order, with their vectors (V's columns)
+    w = [a[0][0], a[1][1], a[2][2]]
+    idx = [0, 1, 2]
+    for i in range(3):
+        for k in range(2 - i):
+            if w[idx[k]] > w[idx[k + 1]]:
+                idx[k], idx[k + 1] = idx[k + 1], idx[k]
+    w_max = w[idx[2]]
+    cond = w[idx[0]] / w_max if w_max > 0.0 else 0.0
+    dg = [g0, g1, g2 * d2]  # D g
+    step = [0.0, 0.0, 0.0]  # in the scaled space, -Σ over constrained directions of v (v·Dg) / w
+    degenerate = False
+    for e in idx:
+        if not w[e] > degeneracy_ratio * w_max:
+            degenerate = True
+            continue
+        coef = (v[0][e] * dg[0] + v[1][e] * dg[1] + v[2][e] * dg[2]) / w[e]
+        for i in range(3):
+            step[i] -= v[i][e] * coef
+    return step[0], step[1], step[2] * d2, cond, degenerate
 
 
 def _pairs_loop(p, j, usable_or_none, ref_points, ref_normals, trim_fraction):
-    """One ICP iteration's pairs as :func:`match` makes them in numpy (the reference): the
+    """One ICP iteration's pairs as :func:`_icp_numpy` makes them (the reference): the
     readings ``p`` (reference frame) whose nearest reference reading ``j`` has a normal,
     their point-to-line residuals, the best ``trim_fraction`` of them kept, and the
     Jacobian rows. Returns the number paired, the kept readings, residuals and Jacobian."""
@@ -287,7 +396,7 @@ def _pairs_loop(p, j, usable_or_none, ref_points, ref_normals, trim_fraction):
     return m, kept_p, kept_r, jac
 
 
-_pairs_kernel = njit(_pairs_loop)
+_pairs_kernel = njit(_pairs_loop, helper=True)
 
 
 def _normals_loop(points, max_gap, k):
@@ -315,3 +424,7 @@ def _normals_loop(points, max_gap, k):
 
 
 _normals_kernel = njit(_normals_loop)
+
+
+_solve_step = njit(_solve_step, helper=True) or _solve_step
+_icp_kernel = njit(_icp_loop)

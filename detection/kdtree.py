@@ -140,6 +140,7 @@ def _grid_query(points, geometry, shape, start, order, q, bound):
 
 _grid_build = compiled.njit(_grid_build)
 _grid_query = compiled.njit(_grid_query)
+grid_query_kernel = _grid_query  # for kernels that search a grid themselves (the scan matcher's); None without numba
 
 
 class PointTree:
@@ -173,6 +174,13 @@ class PointTree:
         else:
             from scipy.spatial import cKDTree
             self._tree = cKDTree(points)
+
+    @property
+    def grid(self) -> tuple | None:
+        """The grid's arrays, as :data:`grid_query_kernel` takes them before the queries:
+        the points and the grid's geometry, shape, cell starts and order; None when another
+        backend answers (or the tree is empty)."""
+        return None if self._grid is None else (self._points, *self._grid)
 
     def query(self, points: np.ndarray, distance_upper_bound: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
         """Distance to, and index of, the nearest point for each of ``points``.

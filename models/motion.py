@@ -16,17 +16,17 @@ H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
 
 
 @lru_cache(maxsize=256)
-def _cv(dt: float, accel_var: float) -> tuple[np.ndarray, np.ndarray]:
-    F = constant_velocity_F(dt)
+def _cv_Q(dt: float, accel_var: float) -> np.ndarray:
     Q = constant_velocity_Q(dt, accel_var)
-    F.setflags(write=False)
     Q.setflags(write=False)
-    return F, Q
+    return Q
 
 
-def constant_velocity_FQ(dt: float, accel_var: float) -> tuple[np.ndarray, np.ndarray]:
-    """F and Q for ``dt`` seconds, shared (read-only) by every track predicted over the same step."""
-    return _cv(round(dt, 9), accel_var)
+def constant_velocity_step(dt: float, accel_var: float) -> tuple[float, np.ndarray]:
+    """``dt`` rounded to the nanosecond, and Q over it, shared (read-only) by every track
+    predicted over the same step (stamps' jitter makes most steps' ``dt`` a new one)."""
+    dt = round(dt, 9)
+    return dt, _cv_Q(dt, accel_var)
 
 
 def constant_velocity_F(dt: float) -> np.ndarray:
@@ -43,9 +43,8 @@ def constant_velocity_Q(dt: float, accel_var: float) -> np.ndarray:
     scipy's ``block_diag`` at ~0.3 ms a call, and stamps that jitter make every step's
     ``dt`` a new one.
     """
-    q = np.array([[0.25 * dt ** 4, 0.5 * dt ** 3], [0.5 * dt ** 3, dt ** 2]])
-    return np.kron(np.eye(2), q) * accel_var
-
+    a, b, c = 0.25 * dt ** 4 * accel_var, 0.5 * dt ** 3 * accel_var, dt ** 2 * accel_var
+    return np.array([[a, b, 0.0, 0.0], [b, c, 0.0, 0.0], [0.0, 0.0, a, b], [0.0, 0.0, b, c]])
 
 
 # The track filter's two steps written out for the model above (state [x, vx, y, vy], H

@@ -111,6 +111,7 @@ def _transform_loop(pts, c, s, tx, ty):
 
 
 _transform_kernel = compiled.njit(_transform_loop)
+transform_kernel = _transform_kernel  # for kernels that move points themselves; None without numba
 
 
 def interpolate_pose(p0: Pose2D, p1: Pose2D, fraction: float) -> Pose2D:

@@ -10,7 +10,7 @@ import numpy as np
 from filterpy.kalman import KalmanFilter
 
 from people_tracker.detection.free_space import UNSEEN
-from people_tracker.models.motion import H, constant_velocity_FQ, cv_predict, position_update
+from people_tracker.models.motion import H, constant_velocity_step, cv_predict, position_update
 from people_tracker.tracker.existence import Existence, logit
 
 
@@ -142,9 +142,9 @@ class TrackState:
                 self.kf.P[0, 0] += d
                 self.kf.P[2, 2] += d
             else:
-                F, Q = constant_velocity_FQ(dt, self.params.accel_std_mps2 ** 2)
-                # x = F x ;  P = F P Fᵀ + Q  (F's dt as the shared F and Q round it)
-                self.kf.x, self.kf.P = cv_predict(self.kf.x, self.kf.P, float(F[0, 1]), Q)
+                step, Q = constant_velocity_step(dt, self.params.accel_std_mps2 ** 2)
+                # x = F x ;  P = F P Fᵀ + Q
+                self.kf.x, self.kf.P = cv_predict(self.kf.x, self.kf.P, step, Q)
             self.stamp = stamp
         self.update_kind = None
 

@@ -113,3 +113,30 @@ def test_without_anything_to_match_the_predicted_motion_fades_to_rest(fade_s):
         steps.append(before.between(pose).x)
     expected = speed * dt * np.exp(-dt / fade_s * np.arange(6)) if fade_s else np.full(6, speed * dt)
     assert steps == pytest.approx(expected, abs=0.01 * speed * dt)
+
+
+def test_the_scan_matchers_step_is_the_least_squares_step_in_the_constrained_directions():
+    """The written-out eigen-decomposition of the matcher's step against numpy's (LAPACK):
+    the same step (to 1e-9), conditioning and degenerate directions, on random normal
+    equations, corridors (one direction unconstrained) among them."""
+    from people_tracker.detection.icp import _solve_step
+    solve = getattr(_solve_step, "py_func", _solve_step)  # the Python code itself
+    rng = np.random.default_rng(4)
+    kinds = set()
+    for k in range(2000):
+        A = rng.normal(size=(int(rng.integers(3, 80)), 3)) * rng.uniform(0.01, 10, 3)
+        if k % 3 == 0:
+            A[:, 0] = A[:, 1] * rng.uniform(0.5, 2) + rng.normal(0, 1e-4, len(A))
+        H, g, rng_m, ratio = A.T @ A, A.T @ rng.normal(0, 0.05, len(A)), float(rng.uniform(0.2, 9)), 0.06
+        d = np.array([1.0, 1.0, 1.0 / max(rng_m, 1.0)])
+        w, V = np.linalg.eigh(H * np.outer(d, d))
+        good = w > ratio * w[-1]
+        if np.any(np.abs(w[:, None] - ratio * w[-1]) < 1e-6 * w[-1]):
+            continue  # on the threshold: either answer is right
+        expected = d * -(V[:, good] @ ((V[:, good].T @ (d * g)) / w[good]))
+        dx, dy, dth, cond, degenerate = solve(*H[np.triu_indices(3)], *g, rng_m, ratio)
+        np.testing.assert_allclose([dx, dy, dth], expected, rtol=1e-9, atol=1e-12 * np.abs(expected).max())
+        assert cond == pytest.approx(w[0] / w[-1], rel=1e-9, abs=1e-15)
+        assert degenerate == (not good.all())
+        kinds.add(degenerate)
+    assert kinds == {True, False}

@@ -379,3 +379,24 @@ def test_track_filter_steps_agree():
                 ref = position_update(x, P, z, R)
             assert all(a.tobytes() == b.tobytes() for a, b in zip(fast, ref)), f"update {k}.{step}"
             x, P = ref
+
+
+def test_the_scan_matchers_step_is_the_same_compiled_and_in_python():
+    """The Gauss-Newton step of one ICP iteration (a 3x3 eigen-decomposition written out):
+    the same bits from the compiled helper as from Python, degenerate scenes included."""
+    from people_tracker.detection.icp import _solve_step
+    rng = np.random.default_rng(15)
+    degenerate = 0
+    for k in range(3000):
+        A = rng.normal(size=(int(rng.integers(3, 60)), 3)) * rng.uniform(0.01, 10, 3)
+        if k % 3 == 0:
+            A[:, 0] = A[:, 1] * rng.uniform(0.5, 2)  # a corridor: one direction unconstrained
+        if k % 17 == 0:
+            A[:, 2] = 0.0  # nothing constrains the rotation
+        H = A.T @ A
+        g = A.T @ rng.normal(0, 0.05, len(A))
+        args = (H[0, 0], H[0, 1], H[0, 2], H[1, 1], H[1, 2], H[2, 2], *g, float(rng.uniform(0.5, 8)), 0.06)
+        fast, ref = _solve_step(*args), _solve_step.py_func(*args)
+        assert np.array(fast).tobytes() == np.array(ref).tobytes(), k
+        degenerate += ref[4]
+    assert 500 < degenerate < 3000
