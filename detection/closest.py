@@ -39,8 +39,5 @@ def closest_point_static(tree_c: PointTree, points_p_in_c: np.ndarray, thr_p: np
     n, m = len(points_c_in_p), len(points_p_in_c)
     if n == 0 or m == 0:
         return np.zeros(n, dtype=bool), np.zeros(m, dtype=bool)
-    # distances beyond the largest threshold come back as inf: the search stops early
-    d_c, _ = tree_p.query(points_c_in_p, float(thr_c.max()))
-    d_p, _ = tree_c.query(points_p_in_c, float(thr_p.max()))
-    return d_c < thr_c, d_p < thr_p
+    return tree_p.within(points_c_in_p, thr_c), tree_c.within(points_p_in_c, thr_p)
 

@@ -283,14 +283,16 @@ class MovingObjectDetector:
         seen = np.zeros(len(q), dtype=np.int64)
         for past in memory:
             rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
+            if not still_only.any():  # whether a reading was there, not which
+                seen += past.tree.within(rel.transform_points(q), thr, inclusive=True)
+                continue
             d, j = past.tree.query(rel.transform_points(q), float(thr.max()))
             hit = d <= thr
-            if still_only.any():
-                if past.static is None or not past.scan.n_valid:  # not labelled: nothing seen still
-                    hit &= ~still_only
-                else:
-                    beam = past.scan.valid_index[np.minimum(j, past.scan.n_valid - 1)]
-                    hit &= ~still_only | past.static[beam]
+            if past.static is None or not past.scan.n_valid:  # not labelled: nothing seen still
+                hit &= ~still_only
+            else:
+                beam = past.scan.valid_index[np.minimum(j, past.scan.n_valid - 1)]
+                hit &= ~still_only | past.static[beam]
             seen += hit
         share = _share_per_span(seen >= p.static_memory_min_scans, [spans[k] for k in test])
         keep[test[share >= p.static_memory_share]] = False
@@ -309,8 +311,7 @@ class MovingObjectDetector:
                 return np.zeros(len(spans), dtype=bool)
             moved = past.pose.between(pose).transform_points(q) - q
             shift = np.hypot(moved[:, 0], moved[:, 1])
-            d, _ = past.tree.query(q, float(thr.max()))
-            rigid &= (d <= thr) & (shift > 2.0 * thr)
+            rigid &= past.tree.within(q, thr, inclusive=True) & (shift > 2.0 * thr)
         return _share_per_span(rigid, spans) >= 0.5
 
     def _earlier(self, stamp: float) -> list[_Past]:

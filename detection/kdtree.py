@@ -138,7 +138,46 @@ def _grid_query(points, geometry, shape, start, order, q, bound):
     return dist, index
 
 
+def _grid_within(points, geometry, shape, start, order, q, radius, bound, inclusive):
+    """For each of ``q`` (m, 2), whether its nearest point, searched closer than ``bound``
+    (metres), lies closer than ``radius[t]`` (or as close, ``inclusive``): what
+    :func:`_grid_query` answers with the distance compared to ``radius``, but the search
+    ends at the first point close enough, and covers only the cells within ``radius[t]``."""
+    x0, y0, cell = geometry[0], geometry[1], geometry[2]
+    nx, ny = shape[0], shape[1]
+    out = np.zeros(len(q), np.bool_)
+    for t in range(len(q)):
+        qx, qy, r = q[t, 0], q[t, 1], radius[t]
+        if not (np.isfinite(qx) and np.isfinite(qy)) or not r >= 0.0:
+            continue
+        # the cells a point within r can lie in (a millionth of a cell wider: rounding)
+        i_lo = max(int(math.floor((qx - r - x0) / cell - 1e-6)), 0)
+        i_hi = min(int(math.floor((qx + r - x0) / cell + 1e-6)), nx - 1)
+        j_lo = max(int(math.floor((qy - r - y0) / cell - 1e-6)), 0)
+        j_hi = min(int(math.floor((qy + r - y0) / cell + 1e-6)), ny - 1)
+        found = False
+        for i in range(i_lo, i_hi + 1):
+            for j in range(j_lo, j_hi + 1):
+                c = i * ny + j
+                for s in range(start[c], start[c + 1]):
+                    p = order[s]
+                    dx, dy = qx - points[p, 0], qy - points[p, 1]
+                    d2 = dx * dx + dy * dy
+                    if d2 < bound * bound:  # as the search: within the bound, squared distances compared
+                        d = math.sqrt(d2)
+                        if d < r or (inclusive and d == r):
+                            found = True
+                            break
+                if found:
+                    break
+            if found:
+                break
+        out[t] = found
+    return out
+
+
 _grid_build = compiled.njit(_grid_build)
+_grid_within = compiled.njit(_grid_within)
 _grid_query = compiled.njit(_grid_query)
 grid_query_kernel = _grid_query  # for kernels that search a grid themselves (the scan matcher's); None without numba
 
@@ -181,6 +220,20 @@ class PointTree:
         the points and the grid's geometry, shape, cell starts and order; None when another
         backend answers (or the tree is empty)."""
         return None if self._grid is None else (self._points, *self._grid)
+
+    def within(self, points: np.ndarray, radius: np.ndarray, inclusive: bool = False) -> np.ndarray:
+        """Whether each of ``points`` (m, 2; metres, the tree's frame) has a point of the
+        tree closer than its ``radius`` (m,; metres), or as close when ``inclusive``:
+        ``d < radius`` (``d <= radius``) for ``d, _ = query(points, radius.max())``, the same
+        answer, found faster on the grid (the search stops at the first point close enough).
+        """
+        q = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        radius = np.ascontiguousarray(radius, dtype=np.float64)
+        bound = float(radius.max()) if len(radius) else 0.0
+        if self._grid is not None and compiled.on:
+            return _grid_within(self._points, *self._grid, q, radius, bound, inclusive)
+        d, _ = self.query(q, bound)
+        return d <= radius if inclusive else d < radius
 
     def query(self, points: np.ndarray, distance_upper_bound: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
         """Distance to, and index of, the nearest point for each of ``points``.

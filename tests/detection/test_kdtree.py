@@ -75,6 +75,39 @@ def test_the_grid_agrees_where_its_cells_are_odd():
     assert d.tolist() == [0.0, np.inf, np.inf] and i.tolist() == [0, 5, 5]  # nothing is near no place
 
 
+def _within_agrees(ref, query, radius):
+    """``within`` answers what ``query`` and a comparison answer, on every backend, with a
+    strict and an inclusive bound."""
+    for backend in kdtree.BACKENDS:
+        tree = PointTree(ref, backend)
+        d, _ = tree.query(query, float(radius.max()))
+        np.testing.assert_array_equal(tree.within(query, radius), d < radius, err_msg=backend)
+        np.testing.assert_array_equal(tree.within(query, radius, inclusive=True), d <= radius, err_msg=backend)
+
+
+def test_within_a_radius_is_the_nearest_distance_compared(moving_bag):
+    _, scans = _scans(moving_bag, 40)
+    rng = np.random.default_rng(6)
+    hits = 0
+    for (a, _, _), (b, _, _) in zip(scans, scans[3:]):
+        q = b.valid_points + rng.normal(0.0, 0.05, b.valid_points.shape)
+        radius = rng.uniform(0.0, 0.15, len(q))
+        _within_agrees(a.valid_points, q, radius)
+        hits += int(PointTree(a.valid_points).within(q, radius).sum())
+    assert hits > 1000
+    # on the radius exactly, the largest radius (the search's bound) included; nowhere; and
+    # a tree of one place many times
+    ref = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 0.0]])
+    q = np.array([[0.5, 0.0], [1.25, 0.0], [3.0, 0.0], [1.0, 0.1]])
+    _within_agrees(ref, q, np.array([0.5, 0.25, 1.0, 0.1]))
+    _within_agrees(ref, q, np.array([0.5, 0.5, 1.0, 0.1]))
+    _within_agrees(ref, q, np.array([0.5, 0.5, 0.5, 0.1]))
+    assert PointTree(ref).within(q, np.array([0.5, 0.5, 0.5, 0.1]), inclusive=True).tolist() == \
+        [False, True, False, True]  # 0.5 away at the search's bound 0.5: not found, as the search
+    assert PointTree(ref).within(np.array([[np.nan, 0.0]]), np.array([1.0])).tolist() == [False]
+    assert PointTree(np.zeros((0, 2))).within(q, np.full(4, 1.0)).tolist() == [False] * 4
+
+
 @needs_both
 def test_the_tracker_reports_the_same_people_with_every_backend(moving_bag, monkeypatch):
     cfg, scans = _scans(moving_bag, 300)
