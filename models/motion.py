@@ -51,9 +51,9 @@ def constant_velocity_Q(dt: float, accel_var: float) -> np.ndarray:
 # measuring x and y): filterpy's ``KalmanFilter.predict`` and ``update`` do the same
 # arithmetic through a dozen small matrix products, an inverse and a deep copy (about 3
 # and 11 microseconds a call), where the work is a few dozen multiplications. Each step is
-# numpy code on whole rows and columns, and a compiled kernel (numba, the ``[fast]``
-# extra) doing the same operations in the same order, element by element, so the two
-# agree to the bit (``tests/detection/test_compiled.py``); both equal filterpy's to 1e-9
+# Python arithmetic on the 4x4's elements as floats, and a compiled kernel (numba, the
+# ``[fast]`` extra) doing the same operations in the same order, so the two agree to the
+# bit (``tests/detection/test_compiled.py``); both equal filterpy's to 1e-9
 # (``tests/tracker/test_motion.py``: filterpy multiplies whole matrices and inverts by LU,
 # so the last bits differ). The filter's state stays in a filterpy ``KalmanFilter``, whose
 # ``x`` and ``P`` are replaced, not written into, as filterpy does.
@@ -64,20 +64,22 @@ def cv_predict(x: np.ndarray, P: np.ndarray, dt: float, Q: np.ndarray) -> tuple[
     Returns new arrays."""
     if compiled.on:
         return _predict_kernel(x, P, float(dt), Q)
+    # Python floats (a 4x4 is too small for numpy's calls to pay), element by element as the kernel
+    x0, x1, x2, x3 = x.tolist()
+    (p00, p01, p02, p03), (p10, p11, p12, p13), (p20, p21, p22, p23), (p30, p31, p32, p33) = P.tolist()
+    q = Q.tolist()
     # x = F x: each position moves by its velocity times dt
-    xn = x.copy()
-    xn[0::2] = x[0::2] + dt * x[1::2]
+    xn = [x0 + dt * x1, x1, x2 + dt * x3, x3]
     # F P: the position rows gain dt times the velocity rows
-    FP = P.copy()
-    FP[0::2] = P[0::2] + dt * P[1::2]
+    f = [[p00 + dt * p10, p01 + dt * p11, p02 + dt * p12, p03 + dt * p13], [p10, p11, p12, p13],
+         [p20 + dt * p30, p21 + dt * p31, p22 + dt * p32, p23 + dt * p33], [p30, p31, p32, p33]]
     # (F P) Fᵀ: the position columns gain dt times the velocity columns; then + Q
-    M = FP.copy()
-    M[:, 0::2] = FP[:, 0::2] + dt * FP[:, 1::2]
-    return xn, M + Q
+    Pn = [[(r[0] + dt * r[1]) + qr[0], r[1] + qr[1], (r[2] + dt * r[3]) + qr[2], r[3] + qr[3]] for r, qr in zip(f, q)]
+    return np.array(xn), np.array(Pn)
 
 
 def _predict_loop(x, P, dt, Q):
-    """:func:`cv_predict`'s numpy code, element by element (compiled by numba)."""
+    """:func:`cv_predict`'s Python code in a loop (compiled by numba): the same operations."""
     xn = x.copy()
     for i in (0, 2):
         xn[i] = x[i] + dt * x[i + 1]
@@ -100,28 +102,30 @@ def position_update(x: np.ndarray, P: np.ndarray, z: np.ndarray, R: np.ndarray) 
     Returns new arrays."""
     if compiled.on:
         return _update_kernel(x, P, z, R)
+    x, p, (r00, r01), (r10, r11) = x.tolist(), P.tolist(), *R.tolist()
     # S = H P Hᵀ + R (H picks rows and columns 0 and 2), and its inverse written out
-    s00, s01, s10, s11 = P[0, 0] + R[0, 0], P[0, 2] + R[0, 1], P[2, 0] + R[1, 0], P[2, 2] + R[1, 1]
+    s00, s01, s10, s11 = p[0][0] + r00, p[0][2] + r01, p[2][0] + r10, p[2][2] + r11
     det = s00 * s11 - s01 * s10
     i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
     # K = P Hᵀ S⁻¹
-    k0 = P[:, 0] * i00 + P[:, 2] * i10
-    k1 = P[:, 0] * i01 + P[:, 2] * i11
+    k0 = [row[0] * i00 + row[2] * i10 for row in p]
+    k1 = [row[0] * i01 + row[2] * i11 for row in p]
     # x = x + K (z - H x)
-    y0, y1 = z[0] - x[0], z[1] - x[2]
-    xn = x + (k0 * y0 + k1 * y1)
+    y0, y1 = float(z[0]) - x[0], float(z[1]) - x[2]
+    xn = [x[i] + (k0[i] * y0 + k1[i] * y1) for i in range(4)]
     # A P, with A = I - K H: each row i loses K[i] times P's rows 0 and 2
-    AP = P - k0[:, None] * P[0] - k1[:, None] * P[2]
-    # (A P) Aᵀ: each column j loses K[j] times (A P)'s columns 0 and 2
-    APA = AP - AP[:, 0:1] * k0 - AP[:, 2:3] * k1
-    # + K R Kᵀ
-    kr0 = k0 * R[0, 0] + k1 * R[1, 0]
-    kr1 = k0 * R[0, 1] + k1 * R[1, 1]
-    return xn, APA + (kr0[:, None] * k0 + kr1[:, None] * k1)
+    ap = [[p[i][j] - k0[i] * p[0][j] - k1[i] * p[2][j] for j in range(4)] for i in range(4)]
+    # (A P) Aᵀ: each column j loses K[j] times (A P)'s columns 0 and 2; + K R Kᵀ
+    Pn = []
+    for i in range(4):
+        kr0, kr1 = k0[i] * r00 + k1[i] * r10, k0[i] * r01 + k1[i] * r11
+        a = ap[i]
+        Pn.append([(a[j] - a[0] * k0[j] - a[2] * k1[j]) + (kr0 * k0[j] + kr1 * k1[j]) for j in range(4)])
+    return np.array(xn), np.array(Pn)
 
 
 def _update_loop(x, P, z, R):
-    """:func:`position_update`'s numpy code, element by element (compiled by numba)."""
+    """:func:`position_update`'s Python code in a loop (compiled by numba): the same operations."""
     s00, s01, s10, s11 = P[0, 0] + R[0, 0], P[0, 2] + R[0, 1], P[2, 0] + R[1, 0], P[2, 2] + R[1, 1]
     det = s00 * s11 - s01 * s10
     i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
