@@ -54,11 +54,35 @@ def run_bounds(points: np.ndarray, gap_threshold: np.ndarray, labels: np.ndarray
     Returns an int array of shape (runs + 1,), starting at 0 and ending at ``len(points)``.
     """
     n = len(points)
+    if compiled.on and n:
+        pts = np.ascontiguousarray(points, dtype=np.float64)
+        gap = np.ascontiguousarray(gap_threshold, dtype=np.float64)
+        if labels is None:
+            return _run_bounds_kernel(pts, gap, np.zeros(n, np.int64), False)
+        return _run_bounds_kernel(pts, gap, np.ascontiguousarray(labels, dtype=np.int64), True)
     step = points[1:] - points[:-1]
     cut = np.hypot(step[:, 0], step[:, 1]) >= np.maximum(gap_threshold[:-1], gap_threshold[1:])
     if labels is not None:
         cut |= labels[1:] != labels[:-1]
     return np.concatenate([[0], np.flatnonzero(cut) + 1, [n]])
+
+
+def _run_bounds_loop(points, gap_threshold, labels, by_label):
+    """:func:`run_bounds` (n >= 1) as one loop: the same comparisons, in int64 as numpy's
+    concatenation gives them."""
+    n = len(points)
+    bounds = np.empty(n + 1, np.int64)
+    bounds[0] = 0
+    k = 1
+    for i in range(n - 1):
+        step = np.hypot(points[i + 1, 0] - points[i, 0], points[i + 1, 1] - points[i, 1])
+        a, b = gap_threshold[i], gap_threshold[i + 1]
+        larger = a if (a >= b or a != a) else b  # np.maximum: nan when either is
+        if step >= larger or (by_label and labels[i + 1] != labels[i]):
+            bounds[k] = i + 1
+            k += 1
+    bounds[k] = n
+    return bounds[:k + 1].copy()
 
 
 def means_and_chords(groups: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -93,3 +117,4 @@ def _means_chords_loop(pts, offsets):
 
 
 _means_chords_kernel = compiled.njit(_means_chords_loop)
+_run_bounds_kernel = compiled.njit(_run_bounds_loop)

@@ -7,7 +7,6 @@ controller's command into ``step``; ``models`` never imports ``tracker``.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Callable
 

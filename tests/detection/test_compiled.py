@@ -400,3 +400,27 @@ def test_the_scan_matchers_step_is_the_same_compiled_and_in_python():
         assert np.array(fast).tobytes() == np.array(ref).tobytes(), k
         degenerate += ref[4]
     assert 500 < degenerate < 3000
+
+
+def test_run_bounds_agree():
+    """The segments' boundaries (by gaps, and by gaps and labels), lost readings' nan
+    thresholds, ties on the threshold and single readings included."""
+    from people_tracker.detection.segments import run_bounds
+    rng = np.random.default_rng(16)
+    cuts = 0
+    for k in range(2000):
+        n = int(rng.integers(1, 200))
+        pts = np.cumsum(rng.normal(0, 0.05, (n, 2)), axis=0)
+        gap = rng.uniform(0.01, 0.1, n)
+        if k % 5 == 0 and n > 1:
+            gap[1] = np.hypot(*(pts[1] - pts[0]))  # a step exactly on its threshold: a cut
+        if k % 7 == 0:
+            gap[rng.integers(0, n)] = np.nan
+        labels = rng.integers(0, 3, n).astype(np.int8)
+        for lab in (None, labels):
+            fast = run_bounds(pts, gap, lab)
+            with compiled.numpy_only():
+                ref = run_bounds(pts, gap, lab)
+            assert fast.dtype == ref.dtype and fast.tobytes() == ref.tobytes(), k
+            cuts += len(fast) - 2
+    assert cuts > 10000
