@@ -7,13 +7,14 @@ number of scans from the stamps) and returns per-beam labels and the moving obje
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
 
 from people_tracker.detection.closest import closest_point_static
-from people_tracker.detection.kdtree import PointTree
+from people_tracker.detection.kdtree import PointTree, grid_within_kernel
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
 from people_tracker.detection.objects import MovingObject, describe_all
 from people_tracker.detection.recover import isolated_occluded, recover_moving
@@ -21,7 +22,7 @@ from people_tracker.detection.scan_lines import bin_to_beams, line_labels_kernel
 from people_tracker.detection.segments import means_and_chords, split_runs
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models import compiled
-from people_tracker.models.pose import Pose2D, pairwise_distances
+from people_tracker.models.pose import Pose2D, pairwise_distances, transform_kernel
 from people_tracker.models.scan import Scan
 
 
@@ -134,6 +135,18 @@ def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
     ``rel`` is the earlier sensor pose seen from the current one (current_T_previous);
     ``tree_c``/``tree_p`` are the scans' KD-trees when the caller keeps them.
     """
+    if tree_c is None:
+        tree_c = _tree(scan)
+    if tree_p is None:
+        tree_p = _tree(prev)
+    grids = (tree_c.grid, tree_p.grid)
+    if compiled.on and grids[0] is not None and grids[1] is not None:  # all of the below as one compiled call
+        inv = rel.inverse()
+        return _label_pair_kernel(scan.valid_index, scan.valid_points, scan.ranges, scan.resolution, scan.angle_min,
+                                  scan.angle_increment, scan.n_beams, prev.valid_points, prev.resolution,
+                                  *rel._cos_sin, rel.x, rel.y, *inv._cos_sin, inv.x, inv.y,
+                                  _free_points(prev, rel, params), *grids[0], *grids[1], params.k_closest,
+                                  params.closest_floor_m, params.scan_line_window)
     labels = np.zeros(scan.n_beams, dtype=np.int8)  # INVALID
     valid_c = scan.valid_index
     pts_c = scan.valid_points
@@ -142,25 +155,18 @@ def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
     r_p = np.hypot(pts_p[:, 0], pts_p[:, 1])
     # 1. closest points → A_C, A_P
     static_c, static_p = closest_point_static(
-        tree_c if tree_c is not None else _tree(scan), pts_p,
-        range_threshold(r_p, prev.resolution, params.k_closest, params.closest_floor_m),
-        tree_p if tree_p is not None else _tree(prev), rel.inverse().transform_points(pts_c),
+        tree_c, pts_p, range_threshold(r_p, prev.resolution, params.k_closest, params.closest_floor_m),
+        tree_p, rel.inverse().transform_points(pts_c),
         range_threshold(r_c, scan.resolution, params.k_closest, params.closest_floor_m))
     labels[valid_c[static_c]] = STATIC
     # 2. Algorithm 1 on B_C, B_P: the previous readings binned to the current beams
     b_c = valid_c[~static_c]
-    # lines of sight the previous scan saw through (no return): free up to no_return_free_m
-    far = np.flatnonzero(prev.no_return) if params.no_return_free_m > 0 else ()
-    pts_far = None
-    if len(far):
-        a = prev.angles[far]
-        reach = min(prev.range_max, params.no_return_free_m)
-        pts_far = rel.transform_points(reach * np.column_stack([np.cos(a), np.sin(a)]))
+    pts_far = _free_points(prev, rel, params)
     if compiled.on:  # the binning and Algorithm 1 below as one compiled loop
-        labels[b_c] = line_labels_kernel(b_c, scan.ranges[b_c], pts_p, r_p, static_p,
-                                         pts_far if pts_far is not None else np.zeros((0, 2)), scan.angle_min,
+        labels[b_c] = line_labels_kernel(b_c, scan.ranges[b_c], pts_p, r_p, static_p, pts_far, scan.angle_min,
                                          scan.angle_increment, scan.n_beams, params.scan_line_window)
         return labels
+    pts_far = pts_far if len(pts_far) else None
     beam_all = bin_to_beams(pts_p, scan.angle_min, scan.angle_increment, scan.n_beams)
     beam_seen, r_seen = beam_all, r_p
     if pts_far is not None:
@@ -169,6 +175,65 @@ def label_pair(scan: Scan, prev: Scan, rel: Pose2D, params: DetectorParams,
     label_c, _ = scan_line_labels(b_c, scan.ranges[b_c], beam_all[~static_p], r_p[~static_p], scan.n_beams,
                                   params.scan_line_window, beam_seen, r_seen)
     labels[b_c] = label_c
+    return labels
+
+
+def _free_points(prev: Scan, rel: Pose2D, params: DetectorParams) -> np.ndarray:
+    """The lines of sight the earlier scan saw through (no return), free up to
+    ``no_return_free_m``: their far ends in the current sensor frame (metres, shape (k, 2);
+    ``rel`` is current_T_previous)."""
+    far = np.flatnonzero(prev.no_return) if params.no_return_free_m > 0 else ()
+    if not len(far):
+        return np.zeros((0, 2))
+    a = prev.angles[far]
+    reach = min(prev.range_max, params.no_return_free_m)
+    return rel.transform_points(reach * np.column_stack([np.cos(a), np.sin(a)]))
+
+
+def _label_pair_loop(valid_c, pts_c, ranges_c, res_c, angle_min, angle_increment, n_beams, pts_prev, res_p,
+                     c, s, x, y, ci, si, xi, yi, pts_far, c_points, c_geometry, c_shape, c_start, c_order,
+                     p_points, p_geometry, p_shape, p_start, p_order, k_closest, floor, window):
+    """:func:`label_pair`'s numpy code as one loop (compiled by numba): the same operations in
+    the same order. ``c, s, x, y``: current_T_previous's cosine, sine and translation;
+    ``ci, si, xi, yi``: its inverse's; the two grids: the current and the earlier scan's."""
+    labels = np.zeros(n_beams, np.int8)  # INVALID
+    n, m = len(pts_c), len(pts_prev)
+    pts_p = transform_kernel(pts_prev, c, s, x, y)  # previous readings in the current frame
+    r_p = np.empty(m)
+    thr_p = np.empty(m)
+    f_p = k_closest * math.tan(res_p / 2.0)
+    for i in range(m):
+        r_p[i] = np.hypot(pts_p[i, 0], pts_p[i, 1])
+        thr_p[i] = max(f_p * r_p[i], floor)
+    thr_c = np.empty(n)
+    f_c = k_closest * math.tan(res_c / 2.0)
+    for i in range(n):
+        thr_c[i] = max(f_c * ranges_c[valid_c[i]], floor)
+    # 1. closest points → A_C, A_P
+    if n == 0 or m == 0:
+        static_c, static_p = np.zeros(n, np.bool_), np.zeros(m, np.bool_)
+    else:
+        static_c = grid_within_kernel(p_points, p_geometry, p_shape, p_start, p_order,
+                                      transform_kernel(pts_c, ci, si, xi, yi), thr_c, thr_c.max(), False)
+        static_p = grid_within_kernel(c_points, c_geometry, c_shape, c_start, c_order, pts_p, thr_p, thr_p.max(),
+                                      False)
+    k = 0
+    for i in range(n):
+        if static_c[i]:
+            labels[valid_c[i]] = STATIC
+        else:
+            k += 1
+    # 2. Algorithm 1 on B_C, B_P
+    b_c = np.empty(k, np.int64)
+    r_b = np.empty(k)
+    k = 0
+    for i in range(n):
+        if not static_c[i]:
+            b_c[k], r_b[k] = valid_c[i], ranges_c[valid_c[i]]
+            k += 1
+    label_b = line_labels_kernel(b_c, r_b, pts_p, r_p, static_p, pts_far, angle_min, angle_increment, n_beams, window)
+    for i in range(k):
+        labels[b_c[i]] = label_b[i]
     return labels
 
 
@@ -390,3 +455,6 @@ def v_min(params: DetectorParams, resolution: float, ranges_m=(1.0, 3.0, 5.0)) -
         thr = range_threshold(np.asarray(ranges_m), resolution, params.k_closest, params.closest_floor_m)
         out[dt] = (thr / dt).tolist()
     return out
+
+
+_label_pair_kernel = compiled.njit(_label_pair_loop)

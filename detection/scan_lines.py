@@ -173,4 +173,4 @@ def _line_labels_loop(beam_c, range_c, pts_p, range_p, static_p, pts_far, angle_
 
 _nearest_per_beam_loop = njit(_nearest_per_beam_loop, helper=True) or _nearest_per_beam_loop
 _partner_of = njit(_partner_of, helper=True) or _partner_of
-line_labels_kernel = njit(_line_labels_loop)
+line_labels_kernel = njit(_line_labels_loop, helper=True)  # called from the detector's label_pair kernel (and its fallback)

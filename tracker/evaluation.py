@@ -319,7 +319,7 @@ def format_table(result: dict) -> str:
     pct = lambda v: "n/a" if v != v else f"{100 * v:.1f} %"  # noqa: E731
     metres = lambda v: "n/a" if v != v else f"{v:.3f} m"  # noqa: E731
     lines = [
-        (f"protocol", f"{result['protocol']} (match within {result['threshold_m']:g} m)"),
+        ("protocol", f"{result['protocol']} (match within {result['threshold_m']:g} m)"),
         ("frames", f"{result['frames']}"
                    + ("" if result.get("bearing_window_deg") is None else
                       " (people and tracks with bearing {:g}°..{:g}° only)".format(*result["bearing_window_deg"]))),
