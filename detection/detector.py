@@ -237,6 +237,22 @@ def _label_pair_loop(valid_c, pts_c, ranges_c, res_c, angle_min, angle_increment
     return labels
 
 
+def _lookback_loop(stamps, posed, stamp, lookbacks, need_pose):
+    """:meth:`MovingObjectDetector._lookback`'s choices as one loop (compiled by numba): for
+    each lookback, the index of the kept scan it picks, -1 for none."""
+    out = np.full(len(lookbacks), -1, np.int64)
+    for k in range(len(lookbacks)):
+        best, best_gap = -1, np.inf
+        for i in range(len(stamps)):
+            age = stamp - stamps[i]
+            if age >= 0.5 * lookbacks[k] and (posed[i] or not need_pose):
+                gap = abs(age - lookbacks[k])
+                if best < 0 or gap < best_gap:  # np.argmin: the first of equal ones
+                    best, best_gap = i, gap
+        out[k] = best
+    return out
+
+
 def combine(pairs: list[np.ndarray]) -> np.ndarray:
     """One label per reading from several comparisons: moving in any → M; else occluded in
     any → O; else static in any → A; else N."""
@@ -297,6 +313,12 @@ class MovingObjectDetector:
         that long ago (of equally near ones the oldest); each scan once."""
         out: list[_Past] = []
         if not len(self._stamps):
+            return out
+        if compiled.on:  # the choices below as one compiled loop
+            for k in _lookback_kernel(self._stamps, self._posed, float(stamp), np.asarray(lookbacks_s, dtype=float),
+                                      need_pose):
+                if k >= 0 and all(self._history[k] is not o for o in out):
+                    out.append(self._history[k])
             return out
         age = stamp - self._stamps
         for lookback in lookbacks_s:
@@ -458,3 +480,4 @@ def v_min(params: DetectorParams, resolution: float, ranges_m=(1.0, 3.0, 5.0)) -
 
 
 _label_pair_kernel = compiled.njit(_label_pair_loop)
+_lookback_kernel = compiled.njit(_lookback_loop)

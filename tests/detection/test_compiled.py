@@ -424,3 +424,29 @@ def test_run_bounds_agree():
             assert fast.dtype == ref.dtype and fast.tobytes() == ref.tobytes(), k
             cuts += len(fast) - 2
     assert cuts > 10000
+
+
+def test_the_detectors_lookbacks_agree():
+    """The kept scans the static memory and the free-space tests look back to: the same
+    choice compiled as in numpy, ties (the oldest of equally near ones), scans without a
+    pose and lookbacks longer than the history included."""
+    from collections import deque
+
+    from people_tracker.detection.detector import MovingObjectDetector
+    rng = np.random.default_rng(17)
+    chosen = 0
+    for k in range(3000):
+        det = MovingObjectDetector()
+        n = int(rng.integers(1, 50))
+        stamps = np.sort(rng.uniform(0, 3, n)).round(1 if k % 2 else 6)  # rounded: ties
+        det._history = deque(object() for _ in range(n))
+        det._stamps, det._posed = stamps, rng.random(n) < 0.8
+        stamp = float(stamps[-1] + rng.uniform(0, 0.2))
+        lookbacks = tuple(rng.uniform(0.05, 4.0, int(rng.integers(1, 4))).round(1))
+        for need_pose in (False, True):
+            fast = det._lookback(stamp, lookbacks, need_pose)
+            with compiled.numpy_only():
+                ref = det._lookback(stamp, lookbacks, need_pose)
+            assert [id(o) for o in fast] == [id(o) for o in ref], k
+            chosen += len(ref)
+    assert chosen > 5000
