@@ -236,7 +236,7 @@ def _icp_numpy(src, reference: ReferenceScan, prior: Pose2D, params: IcpParams):
             return False, x, y, th, it, rms, overlap, cond, degenerate
         j = j[found]
         p, q, nq = p[found], reference.points[j], reference.normals[j]
-        # point-to-line residual (from +0.0, as einsum's dot product)
+        # point-to-line residual (from +0.0, as the compiled pairs start it)
         r = 0.0 + (p[:, 0] - q[:, 0]) * nq[:, 0] + (p[:, 1] - q[:, 1]) * nq[:, 1]
         # trimmed: keep the best share of the pairs (a partition, not a sort)
         absr = np.abs(r)
