@@ -253,6 +253,29 @@ def _lookback_loop(stamps, posed, stamp, lookbacks, need_pose):
     return out
 
 
+def _carried_loop(q, thr, c, s, x, y, points, geometry, shape, start, order, rigid):
+    """One earlier scan's part of :meth:`MovingObjectDetector._carried` as one loop
+    (compiled by numba; the numpy code's operations), ``rigid`` updated in place: a reading
+    stays rigid when the earlier scan had one within its threshold (inclusive) at the same
+    sensor-frame place, and the sensor's motion since (``c, s, x, y``: the earlier pose's
+    ``between`` the current one) would have moved a fixed reading there by over twice it."""
+    moved = transform_kernel(q, c, s, x, y)
+    near = grid_within_kernel(points, geometry, shape, start, order, q, thr, thr.max(), True)
+    for i in range(len(q)):
+        shift = np.hypot(moved[i, 0] - q[i, 0], moved[i, 1] - q[i, 1])
+        rigid[i] = rigid[i] and near[i] and shift > 2.0 * thr[i]
+
+
+def _seen_loop(q, thr, c, s, x, y, points, geometry, shape, start, order, seen):
+    """One earlier scan's part of the static memory as one loop (compiled by numba; the numpy
+    code's operations): ``seen`` counts, in place, the readings ``q`` the earlier scan had a
+    reading within ``thr`` (inclusive) of, once moved into its frame (``c, s, x, y``)."""
+    near = grid_within_kernel(points, geometry, shape, start, order, transform_kernel(q, c, s, x, y), thr, thr.max(),
+                              True)
+    for i in range(len(q)):
+        seen[i] += near[i]
+
+
 def combine(pairs: list[np.ndarray]) -> np.ndarray:
     """One label per reading from several comparisons: moving in any → M; else occluded in
     any → O; else static in any → A; else N."""
@@ -371,7 +394,11 @@ class MovingObjectDetector:
         for past in memory:
             rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
             if not still_only.any():  # whether a reading was there, not which
-                seen += past.tree.within(rel.transform_points(q), thr, inclusive=True)
+                grid = past.tree.grid
+                if compiled.on and grid is not None:
+                    _seen_kernel(q, thr, *rel._cos_sin, rel.x, rel.y, *grid, seen)
+                else:
+                    seen += past.tree.within(rel.transform_points(q), thr, inclusive=True)
                 continue
             d, j = past.tree.query(rel.transform_points(q), float(thr.max()))
             hit = d <= thr
@@ -396,7 +423,12 @@ class MovingObjectDetector:
         for past in memory:
             if past.pose is None:
                 return np.zeros(len(spans), dtype=bool)
-            moved = past.pose.between(pose).transform_points(q) - q
+            rel = past.pose.between(pose)
+            grid = past.tree.grid
+            if compiled.on and grid is not None and len(q):  # the three lines below as one compiled loop
+                _carried_kernel(q, thr, *rel._cos_sin, rel.x, rel.y, *grid, rigid)
+                continue
+            moved = rel.transform_points(q) - q
             shift = np.hypot(moved[:, 0], moved[:, 1])
             rigid &= past.tree.within(q, thr, inclusive=True) & (shift > 2.0 * thr)
         return _share_per_span(rigid, spans) >= 0.5
@@ -481,3 +513,5 @@ def v_min(params: DetectorParams, resolution: float, ranges_m=(1.0, 3.0, 5.0)) -
 
 _label_pair_kernel = compiled.njit(_label_pair_loop)
 _lookback_kernel = compiled.njit(_lookback_loop)
+_carried_kernel = compiled.njit(_carried_loop)
+_seen_kernel = compiled.njit(_seen_loop)

@@ -177,7 +177,7 @@ def _grid_within(points, geometry, shape, start, order, q, radius, bound, inclus
 
 
 _grid_build = compiled.njit(_grid_build)
-_grid_within = compiled.njit(_grid_within)
+_grid_within = compiled.njit(_grid_within, helper=True)  # called from the detector's kernels (and PointTree.within)
 grid_within_kernel = _grid_within  # for kernels that test radii themselves; None without numba
 _grid_query = compiled.njit(_grid_query)
 grid_query_kernel = _grid_query  # for kernels that search a grid themselves (the scan matcher's); None without numba
