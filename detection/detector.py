@@ -391,9 +391,10 @@ class MovingObjectDetector:
         thr = range_threshold(ranges[idx], scan.resolution, p.static_memory_k * p.k_closest,
                               p.static_memory_k * p.closest_floor_m)
         seen = np.zeros(len(q), dtype=np.int64)
+        any_still_only = bool(still_only.any())
         for past in memory:
             rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
-            if not still_only.any():  # whether a reading was there, not which
+            if not any_still_only:  # whether a reading was there, not which
                 grid = past.tree.grid
                 if compiled.on and grid is not None:
                     _seen_kernel(q, thr, *rel._cos_sin, rel.x, rel.y, *grid, seen)

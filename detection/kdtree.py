@@ -138,6 +138,24 @@ def _grid_query(points, geometry, shape, start, order, q, bound):
     return dist, index
 
 
+def _any_within(points, ny, start, order, i_lo, i_hi, j_lo, j_hi, qx, qy, r, bound, inclusive):
+    """Whether a point of the cells ``i_lo..i_hi`` × ``j_lo..j_hi`` lies within ``r`` of
+    (``qx``, ``qy``): closer (or as close, ``inclusive``), and closer than ``bound``, as the
+    search compares squared distances; the first such point ends the search."""
+    for i in range(i_lo, i_hi + 1):
+        for j in range(j_lo, j_hi + 1):
+            c = i * ny + j
+            for s in range(start[c], start[c + 1]):
+                p = order[s]
+                dx, dy = qx - points[p, 0], qy - points[p, 1]
+                d2 = dx * dx + dy * dy
+                if d2 < bound * bound:
+                    d = math.sqrt(d2)
+                    if d < r or (inclusive and d == r):
+                        return True
+    return False
+
+
 def _grid_within(points, geometry, shape, start, order, q, radius, bound, inclusive):
     """For each of ``q`` (m, 2), whether its nearest point, searched closer than ``bound``
     (metres), lies closer than ``radius[t]`` (or as close, ``inclusive``): what
@@ -155,28 +173,12 @@ def _grid_within(points, geometry, shape, start, order, q, radius, bound, inclus
         i_hi = min(int(math.floor((qx + r - x0) / cell + 1e-6)), nx - 1)
         j_lo = max(int(math.floor((qy - r - y0) / cell - 1e-6)), 0)
         j_hi = min(int(math.floor((qy + r - y0) / cell + 1e-6)), ny - 1)
-        found = False
-        for i in range(i_lo, i_hi + 1):
-            for j in range(j_lo, j_hi + 1):
-                c = i * ny + j
-                for s in range(start[c], start[c + 1]):
-                    p = order[s]
-                    dx, dy = qx - points[p, 0], qy - points[p, 1]
-                    d2 = dx * dx + dy * dy
-                    if d2 < bound * bound:  # as the search: within the bound, squared distances compared
-                        d = math.sqrt(d2)
-                        if d < r or (inclusive and d == r):
-                            found = True
-                            break
-                if found:
-                    break
-            if found:
-                break
-        out[t] = found
+        out[t] = _any_within(points, ny, start, order, i_lo, i_hi, j_lo, j_hi, qx, qy, r, bound, inclusive)
     return out
 
 
 _grid_build = compiled.njit(_grid_build)
+_any_within = compiled.njit(_any_within, helper=True) or _any_within
 _grid_within = compiled.njit(_grid_within, helper=True)  # called from the detector's kernels (and PointTree.within)
 grid_within_kernel = _grid_within  # for kernels that test radii themselves; None without numba
 _grid_query = compiled.njit(_grid_query)
