@@ -14,6 +14,7 @@ from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
 from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.io.bag1 import open_bag1
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
 ODOMETRY = "nav_msgs/msg/Odometry"
@@ -26,7 +27,10 @@ _STAMP_CDR_BE = struct.Struct(">iI")
 
 
 def open_bag(path: str | Path) -> AnyReader:
-    """Open a recording for reading, or raise :class:`InputError` naming what is wrong."""
+    """Open a recording for reading, or raise :class:`InputError` naming what is wrong.
+
+    A ROS 1 bag opens with :class:`~people_tracker.tracker.io.bag1.Bag1Reader` (the same
+    messages, read a few times faster) when that reader can read it, else with ``rosbags``."""
     p = Path(path)
     if not p.exists():
         raise InputError(f"input '{p}' does not exist")
@@ -42,6 +46,8 @@ def open_bag(path: str | Path) -> AnyReader:
         if p.stat().st_size == 0:
             raise InputError(f"input '{p}' is empty")
     kind = "ROS 1 bag" if p.suffix == ".bag" else "ROS 2 recording"
+    if p.suffix == ".bag" and (fast := open_bag1(p)) is not None:
+        return fast
     try:
         reader = AnyReader([p], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()
@@ -107,35 +113,108 @@ _U32 = {True: struct.Struct("<I"), False: struct.Struct(">I")}
 _POSE = {True: struct.Struct("<7d"), False: struct.Struct(">7d")}
 
 
+def _align(at: int, base: int, size: int, ros1: bool) -> int:
+    """``at`` moved to the next multiple of ``size`` from ``base`` (CDR); unchanged in ROS 1,
+    which packs its values."""
+    return at if ros1 else base + (at - base + size - 1) // size * size
+
+
+def _string(raw, at: int, ros1: bool, little: bool, decode: bool = True) -> tuple[str, int]:
+    """The string at ``at`` (a uint32 length, then the bytes; CDR counts and drops a
+    closing NUL; "" unless ``decode``) and where the next value starts. Raises ValueError
+    when cut short."""
+    if at + 4 > len(raw):
+        raise ValueError("cut short")
+    n = _U32[little].unpack_from(raw, at)[0]
+    end = at + 4 + n
+    if end > len(raw) or (not ros1 and n == 0):
+        raise ValueError("cut short")
+    return (bytes(raw[at + 4:end if ros1 else end - 1]).decode() if decode else ""), end
+
+
+def _odometry_head(raw, ros1: bool, frames: bool) -> tuple[bool, str, str, int] | None:
+    """(little endian, ``header.frame_id``, ``child_frame_id``, where ``pose.pose`` starts)
+    of a serialized ``nav_msgs/Odometry``, or None when the bytes do not have that layout.
+
+    The message is a ``std_msgs/Header`` (ROS 1: seq, stamp; CDR: stamp after a 4-byte
+    encapsulation header), ``frame_id``, ``child_frame_id``, then the pose's seven float64.
+    ROS 1 packs them; CDR aligns each value to its size, counted from the end of the
+    encapsulation header. The frame names are "" unless ``frames``."""
+    if ros1:
+        little, base, at = True, 0, 12  # seq, stamp
+    else:
+        if len(raw) < 4:
+            return None
+        little, base, at = bool(raw[1] & 1), 4, 12  # encapsulation header, stamp
+    try:
+        frame, at = _string(raw, _align(at, base, 4, ros1), ros1, little, frames)
+        child, at = _string(raw, _align(at, base, 4, ros1), ros1, little, frames)
+    except (ValueError, UnicodeDecodeError):
+        return None
+    at = _align(at, base, 8, ros1)
+    return (little, frame, child, at) if at + 56 <= len(raw) else None
+
+
 def peek_odometry_pose(raw: bytes | memoryview, ros1: bool) -> tuple[float, ...] | None:
     """``pose.pose`` of a serialized ``nav_msgs/Odometry``: position x, y, z and orientation
     x, y, z, w, read in place (a full deserialization takes ~50 µs, at 100 Hz odometry a
     noticeable share of the tracker's time); None when the bytes do not have that layout.
+    ``tests/tracker/test_odometry.py`` checks it against the full deserialization on real
+    and simulated recordings."""
+    head = _odometry_head(raw, ros1, False)
+    return None if head is None else _POSE[head[0]].unpack_from(raw, head[3])
 
-    The message is a ``std_msgs/Header`` (stamp, ``frame_id``), ``child_frame_id``, then the
-    pose's seven float64. ROS 1 packs them; CDR aligns each value to its size, counted
-    from the end of its 4-byte encapsulation header. ``tests/tracker/test_odometry.py``
-    checks it against the full deserialization on real and simulated recordings.
-    """
+
+def peek_odometry_frames(raw: bytes | memoryview, ros1: bool) -> tuple[str, str] | None:
+    """(``header.frame_id``, ``child_frame_id``) of a serialized ``nav_msgs/Odometry``,
+    read in place; None when the bytes do not have that layout."""
+    head = _odometry_head(raw, ros1, True)
+    return None if head is None else (head[1], head[2])
+
+
+def peek_transforms(raw: bytes | memoryview, ros1: bool) -> list[tuple[float, str, str, tuple[float, ...]]] | None:
+    """The ``transforms`` of a serialized ``tf2_msgs/TFMessage``, read in place: per
+    transform (stamp in s, ``header.frame_id``, ``child_frame_id``, (translation x, y, z,
+    rotation x, y, z, w)); None when the bytes do not have that layout (the caller then
+    deserializes). Deserializing one costs tens of µs and, the first time, generating the
+    type's decoder; a recording's /tf carries hundreds of them a second.
+
+    Each ``geometry_msgs/TransformStamped`` is a header (ROS 1: seq, stamp; CDR: stamp),
+    ``frame_id``, ``child_frame_id`` and seven float64, after a uint32 count. The bytes must
+    be used up exactly (CDR: up to its last value's alignment)."""
     size = len(raw)
     if ros1:
-        little, base, at = True, 0, 12  # seq, stamp
+        little, base, at = True, 0, 0
     else:
-        if size < 4:
+        if size < 8:
             return None
-        little, base, at = bool(raw[1] & 1), 4, 12  # encapsulation header, stamp
-    u32 = _U32[little]
-    for _ in range(2):  # frame_id, child_frame_id: a uint32 length, then the bytes
-        if not ros1:
-            at = base + (at - base + 3) // 4 * 4
+        little, base, at = bool(raw[1] & 1), 4, 4
+    u32, stamp, pose = _U32[little], _STAMP_ROS1 if ros1 else (_STAMP_CDR_LE if little else _STAMP_CDR_BE), _POSE[little]
+    out = []
+    try:
         if at + 4 > size:
             return None
-        at += 4 + u32.unpack_from(raw, at)[0]
-    if not ros1:
-        at = base + (at - base + 7) // 8 * 8
-    if at + 56 > size:
+        count = u32.unpack_from(raw, at)[0]
+        at += 4
+        if count * 64 > size:  # each takes at least 64 bytes: no need to read a wrong count
+            return None
+        for _ in range(count):
+            if ros1:
+                at += 4  # seq
+            at = _align(at, base, 4, ros1)
+            if at + 8 > size:
+                return None
+            sec, nsec = stamp.unpack_from(raw, at)
+            frame, at = _string(raw, at + 8, ros1, little)
+            child, at = _string(raw, _align(at, base, 4, ros1), ros1, little)
+            at = _align(at, base, 8, ros1)
+            if at + 56 > size:
+                return None
+            out.append((sec + nsec * 1e-9, frame, child, pose.unpack_from(raw, at)))
+            at += 56
+    except (ValueError, UnicodeDecodeError):
         return None
-    return _POSE[little].unpack_from(raw, at)
+    return out if at == size else None
 
 
 def stamp_seconds(stamp) -> float:

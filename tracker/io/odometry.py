@@ -25,8 +25,9 @@ from typing import Callable
 from people_tracker.models.pose import Pose2D, interpolate_pose, yaw_from_quaternion
 from people_tracker.tracker.config import OdometryConfig
 from people_tracker.tracker.errors import InputError
-from people_tracker.tracker.io.bag import (ODOMETRY, TF_MESSAGE, connections_of, peek_odometry_pose, peek_stamp,
-                                          stamp_seconds, topics_of_type)
+from people_tracker.tracker.io.bag import (ODOMETRY, TF_MESSAGE, connections_of, peek_odometry_frames,
+                                          peek_odometry_pose, peek_stamp, peek_transforms, stamp_seconds,
+                                          topics_of_type)
 
 log = logging.getLogger(__name__)
 
@@ -40,10 +41,27 @@ def norm_frame(name: str) -> str:
 
 def pose_from_msg(translation, rotation) -> tuple[Pose2D, float]:
     """Planar pose of a ROS translation + quaternion, and the tilt of its z axis (rad)."""
-    qx, qy, qz, qw = rotation.x, rotation.y, rotation.z, rotation.w
+    return planar_pose(translation.x, translation.y, rotation.x, rotation.y, rotation.z, rotation.w)
+
+
+def planar_pose(x: float, y: float, qx: float, qy: float, qz: float, qw: float) -> tuple[Pose2D, float]:
+    """Planar pose of a translation (x, y; m) and quaternion, and the tilt of its z axis (rad)."""
     # z axis of the rotated frame: R[2,2] = 1 - 2(x² + y²)
     cos_tilt = max(-1.0, min(1.0, 1.0 - 2.0 * (qx * qx + qy * qy)))
-    return Pose2D(translation.x, translation.y, yaw_from_quaternion(qx, qy, qz, qw)), math.acos(cos_tilt)
+    return Pose2D(x, y, yaw_from_quaternion(qx, qy, qz, qw)), math.acos(cos_tilt)
+
+
+def transforms_of(reader, raw) -> list[tuple[float, str, str, Pose2D, float]]:
+    """Every transform of a serialized ``tf2_msgs/TFMessage``: (stamp in s, parent frame,
+    child frame, parent_T_child, tilt in rad); read in place, or deserialized when the bytes
+    have another layout."""
+    fast = peek_transforms(raw, not reader.is2)
+    if fast is not None:
+        return [(stamp, parent, child, *planar_pose(tx, ty, qx, qy, qz, qw))
+                for stamp, parent, child, (tx, ty, _tz, qx, qy, qz, qw) in fast]
+    msg = reader.deserialize(raw, TF_MESSAGE)
+    return [(stamp_seconds(tr.header.stamp), tr.header.frame_id, tr.child_frame_id,
+             *pose_from_msg(tr.transform.translation, tr.transform.rotation)) for tr in msg.transforms]
 
 
 class PoseSeries:
@@ -193,11 +211,9 @@ def discover_tf(reader, window_s: float) -> TfTree:
                                    (dynamic, False, reader.start_time + int(window_s * 1e9))):
         if not conns:
             continue
-        for conn, _t, raw in reader.messages(connections=conns, stop=stop):
-            msg = reader.deserialize(raw, conn.msgtype)
-            for tr in msg.transforms:
-                pose, tilt = pose_from_msg(tr.transform.translation, tr.transform.rotation)
-                tree.add(tr.header.frame_id, tr.child_frame_id, pose, tilt, is_static)
+        for _conn, _t, raw in reader.messages(connections=conns, stop=stop):
+            for _stamp, parent, child, pose, tilt in transforms_of(reader, raw):
+                tree.add(parent, child, pose, tilt, is_static)
     return tree
 
 
@@ -269,7 +285,7 @@ class TfSource:
         self._dynamic = {e.child: PoseSeries(cfg.max_interpolation_gap_s, cfg.max_extrapolation_s)
                          for e in self._chain if not e.static}
         self._needles = [c.encode() for c in self._dynamic]
-        self._deserialize = reader.deserialize
+        self._reader = reader
         path = " → ".join([self.fixed_frame] + [e.child for e in reversed(self._chain)])
         self.description = f"/tf ({path})"
 
@@ -277,12 +293,10 @@ class TfSource:
         # cheap filter: a message that does not name a dynamic child frame is not needed
         if not any(n in raw for n in self._needles):
             return
-        msg = self._deserialize(raw, TF_MESSAGE)
-        for tr in msg.transforms:
-            series = self._dynamic.get(norm_frame(tr.child_frame_id))
+        for stamp, _parent, child, pose, _tilt in transforms_of(self._reader, raw):
+            series = self._dynamic.get(norm_frame(child))
             if series is not None:
-                series.add(stamp_seconds(tr.header.stamp),
-                           pose_from_msg(tr.transform.translation, tr.transform.rotation)[0])
+                series.add(stamp, pose)
 
     def ready(self, stamp: float) -> bool:
         return all(s.newest >= stamp for s in self._dynamic.values())
@@ -305,8 +319,11 @@ def _odometry_child(reader, topic: str) -> tuple[str, str]:
     """(frame_id, child_frame_id) of the first message of an Odometry topic."""
     conns = connections_of(reader, topic)
     for conn, _t, raw in reader.messages(connections=conns):
-        msg = reader.deserialize(raw, conn.msgtype)
-        return norm_frame(msg.header.frame_id), norm_frame(msg.child_frame_id)
+        frames = peek_odometry_frames(raw, not reader.is2)
+        if frames is None:
+            msg = reader.deserialize(raw, conn.msgtype)
+            frames = msg.header.frame_id, msg.child_frame_id
+        return norm_frame(frames[0]), norm_frame(frames[1])
     return "", ""
 
 

@@ -1,0 +1,172 @@
+"""The fast ROS 1 bag reader gives what rosbags gives, and /tf read in place is /tf deserialized."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import DATA
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag1 import Writer
+from rosbags.typesys import Stores, get_typestore
+
+from people_tracker.tracker.io.bag import ODOMETRY, TF_MESSAGE, open_bag, peek_odometry_frames, peek_transforms
+from people_tracker.tracker.io.bag1 import Bag1Reader, open_bag1
+
+REAL_BAGS = sorted(DATA.glob("leigh/**/*.bag")) if DATA.exists() else []
+
+
+def _rosbags(path: Path) -> AnyReader:
+    reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+    reader.open()
+    return reader
+
+
+def _connections(reader) -> list[tuple]:
+    return [(c.id, c.topic, c.msgtype, c.msgdef, c.digest, c.msgcount, c.ext) for c in reader.connections]
+
+
+def _same_as_rosbags(path: Path, decode_each: int = 3) -> int:
+    """Checks both readers agree on ``path``; returns how many messages it holds."""
+    slow, fast = _rosbags(path), open_bag1(path)
+    assert isinstance(fast, Bag1Reader)
+    try:
+        assert _connections(fast) == _connections(slow)
+        assert (fast.start_time, fast.end_time) == (slow.start_time, slow.end_time)
+        every = [(c.id, t, bytes(raw)) for c, t, raw in slow.messages()]
+        assert [(c.id, t, bytes(raw)) for c, t, raw in fast.messages()] == every
+        # some connections, between two times
+        mid = (slow.start_time + slow.end_time) // 2
+        for pick in (slow.connections[:1], slow.connections[-2:]):
+            ids = {c.id for c in pick}
+            want = [(c.id, t, bytes(raw)) for c, t, raw in slow.messages(connections=pick, start=slow.start_time + 1,
+                                                                          stop=mid)]
+            got = [(c.id, t, bytes(raw)) for c, t, raw in fast.messages(
+                connections=[c for c in fast.connections if c.id in ids], start=fast.start_time + 1, stop=mid)]
+            assert got == want
+        decoded: dict[str, int] = {}
+        for conn, _, raw in fast.messages():
+            if decoded.get(conn.msgtype, 0) < decode_each:
+                decoded[conn.msgtype] = decoded.get(conn.msgtype, 0) + 1
+                assert repr(fast.deserialize(raw, conn.msgtype)) == repr(slow.deserialize(raw, conn.msgtype))
+        return len(every)
+    finally:
+        slow.close()
+        fast.close()
+
+
+@pytest.mark.parametrize("path", REAL_BAGS, ids=lambda p: p.name)
+def test_the_fast_reader_reads_every_real_recording_as_rosbags_does(path):
+    assert _same_as_rosbags(path) > 0
+
+
+def test_the_real_recordings_are_there():
+    if not DATA.exists():
+        pytest.skip(f"the real recordings are not here ({DATA}); they live in ../shared/data")
+    assert len(REAL_BAGS) >= 10
+
+
+@pytest.mark.parametrize("compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4],
+                         ids=["none", "bz2", "lz4"])
+def test_the_fast_reader_reads_compressed_chunks_as_rosbags_does(tmp_path, compression):
+    from tests_helpers import run_cli
+
+    plain = tmp_path / "corr.bag"
+    proc = run_cli("simulate", "corridor", "--output", str(plain), "--duration", "3", "--format", "ros1")
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "copy.bag"
+    writer = Writer(out)
+    writer.chunk_threshold = 20_000  # several chunks, so that the merge across chunks is tested
+    if compression is not None:
+        writer.set_compression(compression)
+    src = _rosbags(plain)
+    try:
+        with writer:
+            conns = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data, md5sum=c.digest)
+                     for c in src.connections}
+            for c, t, raw in src.messages():
+                writer.write(conns[c.id], t, raw)
+    finally:
+        src.close()
+    assert _same_as_rosbags(out) > 100
+    reader = open_bag1(out)
+    try:  # what was tested: several chunks, stored as asked
+        kinds = {kind for _, _, kind in reader._chunks.values()}
+        assert len(reader._chunks) > 2 and kinds == {b"none" if compression is None else compression.name.lower().encode()}
+    finally:
+        reader.close()
+
+
+def test_what_the_fast_reader_cannot_read_goes_to_rosbags(tmp_path, moving_bag):
+    cut = tmp_path / "cut.bag"
+    cut.write_bytes(moving_bag.read_bytes()[:200_000])  # no index: the end is gone
+    assert open_bag1(cut) is None
+    with pytest.raises(Exception) as err:
+        open_bag(cut)
+    assert "cannot be read as a ROS 1 bag" in str(err.value)
+    other = tmp_path / "v13.bag"
+    other.write_bytes(b"#ROSBAG V1.3\n" + bytes(100))
+    assert open_bag1(other) is None
+
+
+def test_a_closed_fast_reader_reads_nothing(moving_bag):
+    reader = open_bag1(moving_bag)
+    reader.close()
+    reader.close()  # twice is harmless
+    assert reader.stack is None
+    with pytest.raises(ValueError):
+        next(reader.messages())
+
+
+def _transforms_both_ways(path) -> tuple[list, int]:
+    reader = open_bag(path)
+    try:
+        pairs, odometry = [], 0
+        for conn, _, raw in reader.messages(connections=[c for c in reader.connections
+                                                         if c.msgtype in (TF_MESSAGE, ODOMETRY)]):
+            msg = reader.deserialize(raw, conn.msgtype)
+            if conn.msgtype == ODOMETRY:
+                assert peek_odometry_frames(raw, not reader.is2) == (msg.header.frame_id, msg.child_frame_id)
+                odometry += 1
+                continue
+            full = [(tr.header.stamp.sec + tr.header.stamp.nanosec * 1e-9, tr.header.frame_id, tr.child_frame_id,
+                     (tr.transform.translation.x, tr.transform.translation.y, tr.transform.translation.z,
+                      tr.transform.rotation.x, tr.transform.rotation.y, tr.transform.rotation.z,
+                      tr.transform.rotation.w)) for tr in msg.transforms]
+            pairs.append((peek_transforms(raw, not reader.is2), full))
+        return pairs, odometry
+    finally:
+        reader.close()
+
+
+@pytest.mark.parametrize("fmt", ["mcap", "sqlite3", "ros1"])
+def test_tf_read_in_place_is_the_deserialized_tf(tmp_path, fmt):
+    from tests_helpers import run_cli
+
+    out = tmp_path / ("corr.bag" if fmt == "ros1" else "corr")
+    proc = run_cli("simulate", "corridor", "--output", str(out), "--duration", "2", "--format", fmt)
+    assert proc.returncode == 0, proc.stderr
+    pairs, odometry = _transforms_both_ways(out)
+    assert len(pairs) > 10 and odometry > 10
+    assert all(fast == full for fast, full in pairs)
+
+
+def test_tf_read_in_place_on_the_real_recording(moving_bag):
+    pairs, odometry = _transforms_both_ways(moving_bag)
+    assert len(pairs) == 21744 and odometry == 11561
+    assert all(fast == full for fast, full in pairs)
+    assert len({len(full) for _, full in pairs}) > 1  # messages with one transform and with several
+
+
+def test_tf_of_bytes_cut_short_or_too_long_is_none_not_garbage(moving_bag):
+    reader = open_bag(moving_bag)
+    try:
+        conns = [c for c in reader.connections if c.msgtype == TF_MESSAGE]
+        raw = bytes(next(raw for _, _, raw in reader.messages(connections=conns)))
+    finally:
+        reader.close()
+    assert peek_transforms(raw, True)
+    for cut in (0, 3, 4, 20, len(raw) - 1):
+        assert peek_transforms(raw[:cut], True) is None
+    assert peek_transforms(raw + b"\x00", True) is None
+    assert peek_transforms(b"\x00\x01\x00\x00\xff\xff\xff\xff", False) is None
