@@ -43,7 +43,7 @@ DETECT, ALIGN = "detect: moving objects", "align: de-skew and scan matching"
 PARTS = ((detector, "label_pair", "detect: Algorithm 1 and the closest-point test", DETECT),
          (detector.MovingObjectDetector, "_static_memory", "detect: static memory (with carried objects)", DETECT),
          (detector, "describe_all", "detect: hull centroids and boxes", DETECT),
-         (detector, "recover_moving", "detect: Algorithms 2 and 3", DETECT),
+         (detector, "recover_from_bounds", "detect: Algorithms 2 and 3", DETECT),
          (align_mod, "match", "align: scan matching (ICP)", ALIGN),
          (align_mod, "deskew", "align: de-skew", ALIGN))
 

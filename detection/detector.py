@@ -17,9 +17,9 @@ from people_tracker.detection.closest import closest_point_static
 from people_tracker.detection.kdtree import PointTree, grid_within_kernel
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
 from people_tracker.detection.objects import MovingObject, describe_all
-from people_tracker.detection.recover import isolated_occluded, recover_moving
+from people_tracker.detection.recover import isolated_occluded, recover_from_bounds
 from people_tracker.detection.scan_lines import bin_to_beams, line_labels_kernel, scan_line_labels
-from people_tracker.detection.segments import means_and_chords, split_runs
+from people_tracker.detection.segments import Segment, means_and_chords, run_bounds
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D, pairwise_distances, transform_kernel
@@ -279,12 +279,31 @@ def _seen_loop(q, thr, c, s, x, y, points, geometry, shape, start, order, seen):
 def combine(pairs: list[np.ndarray]) -> np.ndarray:
     """One label per reading from several comparisons: moving in any → M; else occluded in
     any → O; else static in any → A; else N."""
-    out = pairs[0].copy()
     stack = np.stack(pairs)
+    if compiled.on:
+        return _combine_kernel(stack)
+    out = pairs[0].copy()
     valid = out != INVALID
     out[valid] = OUT_OF_VIEW
     for label in (STATIC, OCCLUDED, MOVING):  # later ones win
         out[valid & (stack == label).any(axis=0)] = label
+    return out
+
+
+def _combine_loop(stack):
+    """:func:`combine` of the comparisons stacked as rows, one loop over the readings."""
+    k, n = stack.shape
+    out = stack[0].copy()
+    for i in range(n):
+        if out[i] == INVALID:
+            continue
+        moving = occluded = static = False
+        for j in range(k):
+            lab = stack[j, i]
+            moving |= lab == MOVING
+            occluded |= lab == OCCLUDED
+            static |= lab == STATIC
+        out[i] = MOVING if moving else (OCCLUDED if occluded else (STATIC if static else OUT_OF_VIEW))
     return out
 
 
@@ -483,12 +502,16 @@ class MovingObjectDetector:
         valid = scan.valid_index
         pts = scan.valid_points
         gap = range_threshold(scan.ranges[valid], scan.resolution, p.k_segment, p.segment_floor_m)
-        runs = split_runs(labels[valid], pts, gap)
+        run_labels = labels[valid]
+        bounds = run_bounds(pts, gap, run_labels) if len(pts) else np.zeros(1, np.int64)  # split_runs' runs
         # 4. Algorithms 2 and 3: recover whole objects
-        found = recover_moving(runs, pts, gap, p.min_seed_points, p.min_object_points, p.max_object_size_m,
-                               p.single_object_max_o)
+        found = recover_from_bounds(bounds, run_labels, pts, gap, p.min_seed_points, p.min_object_points,
+                                    p.max_object_size_m, p.single_object_max_o)
         if p.isolated_o_objects:  # objects moving away, whatever else moves (extends Algorithm 3)
             taken = {(r.start, r.stop) for r in found}
+            first = bounds[:-1]
+            big_o = np.flatnonzero((run_labels[first] == OCCLUDED) & (np.diff(bounds) >= p.min_object_points))
+            runs = [Segment(a, b, OCCLUDED, (OCCLUDED,)) for a, b in zip(first[big_o].tolist(), bounds[big_o + 1].tolist())]
             found += [r for r in isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
                                                    p.max_object_size_m) if (r.start, r.stop) not in taken]
         found = [seg for seg in found if seg.size >= p.min_object_points]
@@ -513,6 +536,7 @@ def v_min(params: DetectorParams, resolution: float, ranges_m=(1.0, 3.0, 5.0)) -
 
 
 _label_pair_kernel = compiled.njit(_label_pair_loop)
+_combine_kernel = compiled.njit(_combine_loop)
 _lookback_kernel = compiled.njit(_lookback_loop)
 _carried_kernel = compiled.njit(_carried_loop)
 _seen_kernel = compiled.njit(_seen_loop)

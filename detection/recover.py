@@ -6,6 +6,7 @@ import numpy as np
 
 from people_tracker.detection.labels import MOVING, OCCLUDED, STATIC
 from people_tracker.detection.segments import Segment
+from people_tracker.models import compiled
 
 
 def join(runs: list[Segment], into: int, source: int, points: np.ndarray, join_threshold: np.ndarray,
@@ -107,3 +108,116 @@ def recover_moving(runs: list[Segment], points: np.ndarray, join_threshold: np.n
     if 0 < len(occluded) <= single_object_max_o:
         return occluded
     return []
+
+
+def recover_from_bounds(bounds: np.ndarray, labels: np.ndarray, points: np.ndarray, join_threshold: np.ndarray,
+                        min_seed: int, min_points: int, max_extent: float, single_object_max_o: int) -> list[Segment]:
+    """:func:`recover_moving` of the runs ``bounds`` gives (run k is ``bounds[k]:bounds[k + 1]``
+    of the valid readings, labelled ``labels[bounds[k]]``, as :func:`~people_tracker.detection.segments.run_bounds`
+    returns them): the same segments, from one compiled call when the kernels are on (the
+    Segment objects are then made for the recovered runs alone)."""
+    if len(bounds) < 2:
+        return []
+    if not compiled.on:
+        return recover_moving(runs_of(bounds, labels), points, join_threshold, min_seed, min_points, max_extent,
+                              single_object_max_o)
+    starts, stops, labs, sets = _recover_kernel(bounds, np.ascontiguousarray(labels[bounds[:-1]], dtype=np.int64),
+                                                points, join_threshold, min_seed, min_points, max_extent,
+                                                single_object_max_o)
+    return [Segment(a, b, lab, _SETS[mask]) for a, b, lab, mask in
+            zip(starts.tolist(), stops.tolist(), labs.tolist(), sets.tolist())]
+
+
+def runs_of(bounds: np.ndarray, labels: np.ndarray) -> list[Segment]:
+    """The runs ``bounds`` delimits as Segments, each labelled as its first reading."""
+    starts, stops = bounds[:-1].tolist(), bounds[1:].tolist()
+    return [Segment(a, b, lab, (lab,)) for a, b, lab in zip(starts, stops, labels[bounds[:-1]].tolist())]
+
+
+# a segment's sets as a bit mask (bit label + 1, so the noise label -1 is bit 0), and back
+_LABELS = (-1, 0, 1, 2, 3, 4)
+_SETS = {mask: tuple(lab for lab in _LABELS if mask >> (lab + 1) & 1) for mask in range(1 << len(_LABELS))}
+
+
+def _join_runs(start, stop, lab, sets, alive, prev, nxt, gap_m, close, into, source, points, max_extent):
+    """:func:`join` on runs held as arrays: run ``i`` is alive while it starts a run
+    (``prev``/``nxt`` link the alive ones); a join keeps the outer ends, so the gap before
+    run ``b`` is ``gap_m[b]`` whatever was joined. The same choices, in the same order."""
+    n = len(start)
+    while True:
+        best, best_gap = -1, np.inf
+        for b in range(1, n):
+            if not (alive[b] and close[b]):
+                continue
+            a = prev[b]
+            if not ((lab[a] == into and lab[b] == source) or (lab[a] == source and lab[b] == into)):
+                continue
+            gap = gap_m[b]
+            if gap >= best_gap:
+                continue
+            if np.hypot(points[stop[b] - 1, 0] - points[start[a], 0],
+                        points[stop[b] - 1, 1] - points[start[a], 1]) > max_extent:
+                continue
+            best, best_gap = b, gap
+        if best < 0:
+            return
+        b = best
+        a = prev[b]
+        seg = a if lab[a] == into else b
+        sets[a] = sets[seg] | (1 << (source + 1))
+        stop[a] = stop[b]
+        lab[a] = into
+        alive[b] = False
+        after = nxt[b]
+        nxt[a] = after
+        if after < n:
+            prev[after] = a
+
+
+def _recover_loop(bounds, run_labels, points, join_threshold, min_seed, min_points, max_extent, single_object_max_o):
+    """:func:`recover_moving` on the runs of ``bounds``: the recovered segments' starts,
+    stops, labels and sets (bit masks), in beam order."""
+    n = len(bounds) - 1
+    start = bounds[:-1].copy()
+    stop = bounds[1:].copy()
+    lab = run_labels.copy()
+    any_moving = False
+    for i in range(n):
+        if lab[i] == MOVING:
+            if stop[i] - start[i] < min_seed:
+                lab[i] = -1  # noise: seeds nothing
+            else:
+                any_moving = True
+    sets = np.empty(n, np.int64)
+    for i in range(n):
+        sets[i] = 1 << (lab[i] + 1)
+    keep = np.zeros(n, np.bool_)
+    if any_moving:
+        alive = np.ones(n, np.bool_)
+        prev = np.arange(n) - 1
+        nxt = np.arange(n) + 1
+        gap_m = np.zeros(n)
+        close = np.zeros(n, np.bool_)
+        for b in range(1, n):  # the gap before run b: its first reading and the one before
+            j = start[b]
+            gap_m[b] = np.hypot(points[j, 0] - points[j - 1, 0], points[j, 1] - points[j - 1, 1])
+            ta, tb = join_threshold[j - 1], join_threshold[j]
+            close[b] = gap_m[b] < (ta if (ta >= tb or ta != ta) else tb)  # np.maximum: nan when either is
+        _join_runs(start, stop, lab, sets, alive, prev, nxt, gap_m, close, MOVING, STATIC, points, max_extent)
+        _join_runs(start, stop, lab, sets, alive, prev, nxt, gap_m, close, MOVING, OCCLUDED, points, max_extent)
+        for i in range(n):
+            keep[i] = alive[i] and lab[i] == MOVING
+    else:
+        count = 0
+        for i in range(n):
+            if lab[i] == OCCLUDED and stop[i] - start[i] >= min_points:
+                keep[i] = True
+                count += 1
+        if count > single_object_max_o:
+            keep[:] = False
+    idx = np.flatnonzero(keep)
+    return start[idx], stop[idx], lab[idx], sets[idx]
+
+
+_join_runs = compiled.njit(_join_runs, helper=True) or _join_runs
+_recover_kernel = compiled.njit(_recover_loop)

@@ -450,3 +450,46 @@ def test_the_detectors_lookbacks_agree():
             assert [id(o) for o in fast] == [id(o) for o in ref], k
             chosen += len(ref)
     assert chosen > 5000
+
+
+def test_recovering_objects_agrees():
+    """Algorithms 2 and 3 (joins by the closest pair of ends first, the extent limit, the
+    noise seeds, the single-object case) compiled and on Segment lists, over random
+    labellings of random scans; ties of gaps and lost readings' nan thresholds included."""
+    from people_tracker.detection.recover import recover_from_bounds
+    from people_tracker.detection.segments import run_bounds
+    rng = np.random.default_rng(18)
+    joined = moving = single = 0
+    for k in range(3000):
+        n = int(rng.integers(0, 150))
+        pts = np.cumsum(rng.normal(0, 0.04, (n, 2)), axis=0)
+        if k % 4 == 0 and n:
+            pts = pts.round(2)  # equal gaps: the first in beam order wins
+        gap = rng.uniform(0.02, 0.12, n)
+        if k % 7 == 0 and n:
+            gap[rng.integers(0, n)] = np.nan
+        labels = rng.choice([1, 2, 3, 4], n, p=[0.5, 0.1, 0.3, 0.1] if k % 3 else [0.6, 0.0, 0.3, 0.1]).astype(np.int8)
+        bounds = run_bounds(pts, gap, labels) if n else np.zeros(1, np.int64)
+        args = (bounds, labels, pts, gap, int(rng.integers(1, 4)), int(rng.integers(1, 5)), float(rng.uniform(0.3, 2)),
+                int(rng.integers(0, 3)))
+        fast = recover_from_bounds(*args)
+        with compiled.numpy_only():
+            ref = recover_from_bounds(*args)
+        assert fast == ref, k
+        joined += sum(len(s.sets) > 1 for s in ref)
+        moving += any(s.label == 2 for s in ref)
+        single += any(s.label == 3 for s in ref)
+    assert joined > 1000 and moving > 500 and single > 100, (joined, moving, single)
+
+
+def test_combining_the_comparisons_agrees():
+    from people_tracker.detection.detector import combine
+    rng = np.random.default_rng(19)
+    for k in range(500):
+        n = int(rng.integers(0, 800))
+        pairs = [rng.integers(0, 5, n).astype(np.int8) for _ in range(int(rng.integers(1, 4)))]
+        pairs[1:] = [np.where(pairs[0] == 0, 0, p).astype(np.int8) for p in pairs[1:]]  # invalid in every pair alike
+        fast = combine(pairs)
+        with compiled.numpy_only():
+            ref = combine(pairs)
+        assert fast.dtype == ref.dtype and fast.tobytes() == ref.tobytes(), k
