@@ -71,11 +71,20 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
     if increment * scan.angle_increment <= 0 or abs(increment) < 0.5 * abs(scan.angle_increment):
         increment = scan.angle_increment
     if compiled.on:  # the rest as one compiled loop, the same arithmetic
-        out, source, bearings = _deskew_kernel(scan.ranges, scan.valid_index, scan.angles, scan.no_return, motion.x,
-                                               motion.y, motion.yaw, scan.angle_min, increment, scan.range_min,
-                                               scan.range_max)
-        return Scan(out, scan.angle_min, increment, scan.range_min, scan.range_max, scan.stamp,
-                    scan.frame_id, scan.time_increment, bearings), source
+        raw_bearings = scan.bearings if scan.bearings is not None else np.zeros(0)
+        out, source, bearings, valid, points = _deskew_kernel(
+            scan.ranges, raw_bearings, scan.bearings is not None, motion.x, motion.y, motion.yaw, scan.angle_min,
+            scan.angle_increment, increment, scan.range_min, scan.range_max, compiled.trig_is_numpys)
+        new = Scan(out, scan.angle_min, increment, scan.range_min, scan.range_max, scan.stamp,
+                   scan.frame_id, scan.time_increment, bearings)
+        # what the new scan's properties would compute, computed in the loop (the points
+        # only where the C library's cos and sin are numpy's): the written beams are its valid ones
+        index = np.flatnonzero(valid)
+        for name, value in (("valid", valid), ("valid_index", index)) + (
+                (("points", points), ("valid_points", points[index])) if compiled.trig_is_numpys else ()):
+            value.setflags(write=False)
+            new.__dict__[name] = value  # functools.cached_property's place for it
+        return new, source
     frac = np.arange(n) / (n - 1)
     # per-beam sensor pose relative to the first beam: linear in translation and heading
     yaw = frac * motion.yaw
@@ -101,24 +110,31 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
                 scan.frame_id, scan.time_increment, bearings), source
 
 
-def _deskew_loop(ranges, valid, angles, no_return, mx, my, myaw, angle_min, increment, range_min, range_max):
+def _deskew_loop(ranges, raw_bearings, has_bearings, mx, my, myaw, angle_min, raw_increment, increment, range_min,
+                 range_max, with_points):
     """:func:`deskew_with_source` from its new grid on, for the sweep's motion (mx, my,
     myaw) in the first beam's frame, as one loop (compiled by numba; the numpy code above is
-    the reference): the new ranges, the source beams and the bearings."""
+    the reference): the new ranges, the source beams and the bearings; and the new scan's
+    valid mask and, if ``with_points``, its :attr:`Scan.points` (else nan)."""
     n = len(ranges)
     out = np.empty(n)
-    for i in range(n):
-        out[i] = np.inf if no_return[i] else np.nan
+    for i in range(n):  # Scan.no_return of the raw scan: inf, or at or beyond range_max
+        r = ranges[i]
+        out[i] = np.inf if (np.isinf(r) and r > 0) or (np.isfinite(r) and r >= range_max) else np.nan
     source = np.full(n, -1, np.int64)
     bearings = np.empty(n)
     for i in range(n):
         bearings[i] = angle_min + i * increment
     best = np.full(n, np.inf)  # the nearest reading written to each beam so far
-    for i in valid:
+    for i in range(n):
+        r = ranges[i]
+        if not (np.isfinite(r) and r > range_min and r < range_max):  # Scan.valid of the raw scan
+            continue
+        angle = raw_bearings[i] if has_bearings else angle_min + np.float64(i) * raw_increment  # Scan.angles
         frac = i / (n - 1)
-        a = angles[i] + frac * myaw
-        x = frac * mx + ranges[i] * np.cos(a)
-        y = frac * my + ranges[i] * np.sin(a)
+        a = angle + frac * myaw
+        x = frac * mx + r * np.cos(a)
+        y = frac * my + r * np.sin(a)
         new_r = np.hypot(x, y)
         bearing = np.arctan2(y, x)
         b = beam_of(bearing, angle_min, increment, n)
@@ -128,7 +144,14 @@ def _deskew_loop(ranges, valid, angles, no_return, mx, my, myaw, angle_min, incr
             out[b] = new_r
             source[b] = i
             bearings[b] = bearing
-    return out, source, bearings
+    valid = source >= 0
+    points = np.full((n, 2), np.nan)
+    if with_points:
+        for b in range(n):  # Scan.points: the range (nan where not valid) times cos and sin
+            r = out[b] if valid[b] else np.nan
+            points[b, 0] = r * np.cos(bearings[b])
+            points[b, 1] = r * np.sin(bearings[b])
+    return out, source, bearings, valid, points
 
 
 _deskew_kernel = njit(_deskew_loop)

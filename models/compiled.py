@@ -89,6 +89,18 @@ def _numpy_arctan2_is_the_c_librarys() -> bool:
 arctan2 = np.arctan2 if _numpy_arctan2_is_the_c_librarys() else _c_arctan2
 
 
+def _numpy_trig_is_the_c_librarys() -> bool:
+    """Whether numpy's cos and sin give the C library's bits here (the kernels call the C
+    library's; numpy's own loops for some processors may round differently)."""
+    x = np.random.default_rng(1).uniform(-7.0, 7.0, 4096)
+    return bool(np.array_equal(np.cos(x), [math.cos(v) for v in x])
+                and np.array_equal(np.sin(x), [math.sin(v) for v in x]))
+
+
+# whether a kernel may compute what numpy's cos and sin would (else numpy does it)
+trig_is_numpys = _numpy_trig_is_the_c_librarys()
+
+
 KERNELS: list = []  # every kernel the pipeline calls (not the helpers they call), for the warm-up's test
 
 

@@ -32,7 +32,7 @@ from people_tracker.tracker.existence import Existence, ExistenceParams
 from people_tracker.tracker.following import TargetSelector
 from people_tracker.tracker.pairing import PairingParams, PersonCandidate, leg_centres, owners, pair_legs
 from people_tracker.tracker.standing import StandingInitiator, StandingParams, standing_pairs
-from people_tracker.tracker.static_support import static_support
+from people_tracker.tracker.static_support import scan_segments, static_support
 from people_tracker.tracker.tracks import Track, TrackParams, TrackState
 
 
@@ -169,6 +169,7 @@ class PeopleTracker:
         self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
         self._leg_scores = np.zeros(0)  # ... and their leg probabilities
         self._explained: np.ndarray | None = None  # this scan's readings taken by moving candidates given to tracks
+        self._segments: tuple = (None, None)  # (scan, its scan_segments) for static support's calls on it
         self._tracks: list[TrackState] = []
         self._next_id = 1
         self.last: StepResult | None = None
@@ -617,10 +618,12 @@ class PeopleTracker:
         candidates given to tracks this scan), and holding ``needed`` ones if given (see
         :func:`static_support`)."""
         d = self.detector.params
+        if self._segments[0] is not scan:  # one segmentation a scan, for the several calls
+            self._segments = (scan, scan_segments(scan, d.k_segment, d.segment_floor_m) if scan.n_valid else None)
         return static_support(places, world, scan, d.k_segment, d.segment_floor_m, self.assoc.support_radius_m,
                               self.pairing.max_person_size_m, self.assoc.support_min_points,
                               self.pairing.max_leg_radius_m, self._explained if explained is None else explained,
-                              needed)
+                              needed, self._segments[1])
 
     def _clear_of_tracks(self, xy: np.ndarray, radius_m: float | None = None) -> np.ndarray:
         """Whether each place (world frame) is at least ``radius_m`` (default

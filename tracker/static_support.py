@@ -27,7 +27,8 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
                    segment_floor_m: float, radius_m: float, max_size_m: float,
                    min_points: int, max_leg_radius_m: float = 0.0,
                    explained: np.ndarray | None = None,
-                   needed: np.ndarray | None = None) -> list[np.ndarray | None]:
+                   needed: np.ndarray | None = None,
+                   segmentation: tuple[np.ndarray, int] | None = None) -> list[np.ndarray | None]:
     """For each predicted position (world frame, m), a supporting position or None.
 
     Parameters
@@ -54,28 +55,29 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         else (a passer-by's leg beside someone standing must not pull them along).
     needed : ndarray of bool, shape (n_beams,), optional
         A group must hold at least ``min_points`` of these readings.
+    segmentation : (ndarray, int), optional
+        :func:`scan_segments` of this scan with these ``k_segment`` and ``segment_floor_m``,
+        when the caller keeps it for several calls on one scan.
     """
     out: list[np.ndarray | None] = [None] * len(predictions_world)
     if len(predictions_world) == 0 or scan.n_valid == 0:
         return out
     valid = scan.valid_index
     pts = scan.valid_points
-    gap = range_threshold(scan.ranges[valid], scan.resolution, k_segment, segment_floor_m)
-    bounds = run_bounds(pts, gap)  # the scan's segments, any label
-    seg_of = np.repeat(np.arange(len(bounds) - 1), np.diff(bounds))
+    seg_of, n_segments = segmentation if segmentation is not None else scan_segments(scan, k_segment, segment_floor_m)
     pred_sensor = pose.inverse().transform_points(predictions_world)
     free = np.ones(len(valid), dtype=bool) if explained is None else ~explained[valid]
     needed_valid = None if needed is None else needed[valid]  # per valid reading, as ``free``
     if compiled.on:  # the loop below, compiled: each prediction's group, checked and centred
         found, centres = _support_kernel(
-            pred_sensor, pts, seg_of, len(bounds) - 1, free, needed_valid is not None,
+            pred_sensor, pts, seg_of, n_segments, free, needed_valid is not None,
             needed_valid if needed_valid is not None else free, radius_m, max_size_m, min_points, max_leg_radius_m)
         for t in np.flatnonzero(found):
             out[t] = pose.transform_points(centres[t:t + 1])[0]
         return out
     d = pairwise_distances(pred_sensor, pts)
     d[:, ~free] = np.inf
-    chosen = np.zeros(len(bounds) - 1, dtype=bool)
+    chosen = np.zeros(n_segments, dtype=bool)
     for t in range(len(pred_sensor)):
         near = seg_of[d[t] <= radius_m]
         if len(near) == 0:
@@ -94,6 +96,15 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
             centre = leg_centres(centre, np.array([extent]), max_leg_radius_m)
         out[t] = pose.transform_points(centre)[0]
     return out
+
+
+def scan_segments(scan: Scan, k_segment: float, segment_floor_m: float) -> tuple[np.ndarray, int]:
+    """The scan's segments, any label (the detector's spacing threshold): the segment of
+    each valid reading, in beam order, and how many there are."""
+    valid = scan.valid_index
+    gap = range_threshold(scan.ranges[valid], scan.resolution, k_segment, segment_floor_m)
+    bounds = run_bounds(scan.valid_points, gap)
+    return np.repeat(np.arange(len(bounds) - 1), np.diff(bounds)), len(bounds) - 1
 
 
 def _support_loop(pred_sensor, pts, seg_of, n_segments, free, use_needed, needed, radius_m, max_size_m, min_points,

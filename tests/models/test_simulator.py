@@ -1,6 +1,5 @@
 """The simulator: geometry, gait, visibility, determinism, and the files it writes."""
 
-import hashlib
 import math
 
 import numpy as np
@@ -12,7 +11,7 @@ from people_tracker.models.pose import Pose2D
 from people_tracker.models.raycast import cast_rays
 from people_tracker.models.scenario import ScenarioError, build_simulation, load_scenario, scenario_names
 from people_tracker.models.simulator import Simulation, visible_people
-from people_tracker.models.world import World, build_world
+from people_tracker.models.world import build_world
 from people_tracker.models.scan import Scan
 
 

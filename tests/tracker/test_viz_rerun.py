@@ -2,7 +2,6 @@
 
 import csv
 
-import numpy as np
 import pytest
 
 from tests_helpers import run_cli
