@@ -193,8 +193,12 @@ def match(current: np.ndarray, reference: ReferenceScan, prior: Pose2D, params: 
         return fail("too few readings")
     grid = reference.tree.grid
     if compiled.on and grid is not None:  # the whole loop below as one compiled call
+        src = np.ascontiguousarray(src, dtype=np.float64)
+        if src.flags.writeable:  # one signature for numba whichever src is (a scan's points are read-only)
+            src = src.view()
+            src.setflags(write=False)
         paired, x, y, th, it, rms, overlap, cond, degenerate = _icp_kernel(
-            np.ascontiguousarray(src, dtype=np.float64), float(prior.x), float(prior.y), float(prior.yaw), *grid,
+            src, float(prior.x), float(prior.y), float(prior.yaw), *grid,
             reference.usable_or_none, reference.points, reference.normals, params.max_iterations,
             params.max_correspondence_m, params.min_correspondence_m, params.trim_fraction, params.min_pairs,
             params.degeneracy_ratio)
