@@ -38,6 +38,10 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
         return np.zeros(0, dtype=bool)
     local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
     dist = np.hypot(local[:, 0], local[:, 1])
+    if compiled.on:  # the rest, compiled
+        return _seen_kernel(local, dist, scan.ranges, scan.no_return, scan.angle_min, scan.angle_increment,
+                            scan.range_min, margin_m, moving is not None,
+                            moving if moving is not None else scan.no_return, no_return_free_m)
     beam = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
     inside = beam >= 0
     r = np.full(len(local), -1.0)  # outside the view: neither free nor blocked
@@ -53,6 +57,27 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
         free |= hidden & np.isfinite(r) & (r < dist - margin_m)
     return inside & free
 
+
+def _seen_loop(local, dist, ranges, no_return, angle_min, angle_increment, range_min, margin_m, use_moving, moving,
+               no_return_free_m):
+    """:func:`seen_through` from the points in the sensor frame on, one point at a time
+    (compiled by numba; the numpy code is the reference)."""
+    n_beams = len(ranges)
+    out = np.zeros(len(local), np.bool_)
+    for k in range(len(local)):
+        b = bin_of(local[k, 0], local[k, 1], angle_min, angle_increment, n_beams)
+        if b < 0:
+            continue  # outside the view: neither free nor blocked
+        r = ranges[b]
+        free = (no_return[b] and dist[k] + margin_m <= no_return_free_m) or (
+            np.isfinite(r) and r > range_min and r > dist[k] + margin_m)
+        if use_moving and moving[b] and np.isfinite(r) and r < dist[k] - margin_m:
+            free = True
+        out[k] = free
+    return out
+
+
+_seen_kernel = njit(_seen_loop)
 
 UNSEEN, OCCLUDED, OCCUPIED, SEEN_THROUGH = 0, 1, 2, 3
 

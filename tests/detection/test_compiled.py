@@ -114,6 +114,24 @@ def test_leg_scores_and_line_normals_agree_on_simulated_lasers(laser):
 
 
 @pytest.mark.parametrize("laser", sorted(LASERS))
+def test_seen_through_agrees_on_simulated_lasers(laser):
+    from people_tracker.detection.free_space import seen_through
+    rng = np.random.default_rng(12)
+    seen = 0
+    for scan in _simulated(LASERS[laser], seconds=2.0):
+        pose = Pose2D(*rng.uniform(-1, 1, 2), rng.uniform(-3, 3))
+        places = pose.transform_points(rng.uniform(-8, 8, (60, 2)))  # in view and not, near and far
+        moving = rng.random(scan.n_beams) < 0.3
+        for margin, reach, mask in ((0.1, np.inf, None), (0.3, 3.0, moving), (0.0, 0.0, moving)):
+            fast = seen_through(places, scan, pose, margin, mask, reach)
+            with compiled.numpy_only():
+                ref = seen_through(places, scan, pose, margin, mask, reach)
+            assert fast.dtype == ref.dtype and fast.tobytes() == ref.tobytes()
+            seen += int(ref.sum())
+    assert seen > 100
+
+
+@pytest.mark.parametrize("laser", sorted(LASERS))
 def test_place_visibility_agrees_on_simulated_lasers(laser):
     from people_tracker.detection.free_space import place_visibility
     rng = np.random.default_rng(11)

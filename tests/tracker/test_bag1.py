@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import DATA
 from rosbags.highlevel import AnyReader
@@ -170,3 +171,24 @@ def test_tf_of_bytes_cut_short_or_too_long_is_none_not_garbage(moving_bag):
         assert peek_transforms(raw[:cut], True) is None
     assert peek_transforms(raw + b"\x00", True) is None
     assert peek_transforms(b"\x00\x01\x00\x00\xff\xff\xff\xff", False) is None
+
+
+def test_headers_read_at_once_and_field_by_field_agree(moving_bag, monkeypatch):
+    """The uncompressed path reads every message header at once; where it cannot be sure
+    of a header (here: none on the real recording, so every one is forced), it reads field
+    by field. Both give the same messages."""
+    import people_tracker.tracker.io.bag1 as bag1
+
+    reader = open_bag1(moving_bag)
+    try:
+        assert reader._u8 is not None  # an uncompressed bag: the at-once path
+        conns = [c for c in reader.connections if c.topic in ("/scan", "/odom")]
+        spans = []
+        real = bag1._message_spans
+        monkeypatch.setattr(bag1, "_message_spans", lambda u8, rec: spans.append(real(u8, rec)) or spans[-1])
+        at_once = [(c.id, t, raw) for c, t, raw in reader.messages(connections=conns)]
+        assert len(at_once) == 873 + 11561 and spans[0][2].all()  # every header read for sure
+        monkeypatch.setattr(bag1, "_message_spans", lambda u8, rec: (*real(u8, rec)[:2], np.zeros(len(rec), bool)))
+        assert [(c.id, t, raw) for c, t, raw in reader.messages(connections=conns)] == at_once
+    finally:
+        reader.close()

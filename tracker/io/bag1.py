@@ -94,6 +94,9 @@ class Bag1Reader:
         self._chunk_pos = -1
         self._chunk: bytes | mmap.mmap = b""
         self._chunk_base = 0
+        # the file's bytes, for reading every message's header at once where no chunk is compressed
+        plain = all(kind == b"none" for _, _, kind in self._chunks.values())
+        self._u8 = np.frombuffer(self._map, dtype=np.uint8) if plain else None
 
     # ----- the index, read on opening
     def _record(self, pos: int) -> tuple[dict[bytes, bytes], int, int, int]:
@@ -230,27 +233,46 @@ class Bag1Reader:
         time, where, offset, which = time[order], where[order], offset[order], which[order]
         lo = 0 if start is None else int(np.searchsorted(time, start, side="left"))
         hi = len(time) if stop is None else int(np.searchsorted(time, stop, side="left"))
-        u32 = _U32.unpack_from
-        for t, cpos, off, k in zip(time[lo:hi].tolist(), where[lo:hi].tolist(), offset[lo:hi].tolist(),
-                                   which[lo:hi].tolist()):
+        time, where, offset, which = time[lo:hi], where[lo:hi], offset[lo:hi], which[lo:hi]
+        if self._u8 is not None and len(time):  # uncompressed: every header read at once
+            chunk_pos = np.fromiter(self._chunks, dtype=np.int64, count=len(self._chunks))
+            chunk_data = np.array([start for start, _, _ in self._chunks.values()], dtype=np.int64)
+            order = np.argsort(chunk_pos)
+            starts = chunk_data[order][np.searchsorted(chunk_pos[order], where)]  # each message's chunk data
+            at, size, ok = _message_spans(self._u8, starts + offset)
+            data = self._map
+            for t, cpos, off, k, a, n, good in zip(time.tolist(), where.tolist(), offset.tolist(), which.tolist(),
+                                                   at.tolist(), size.tolist(), ok.tolist()):
+                if not good:  # another layout: read field by field
+                    a, n = self._walk(data, cpos, off, self._chunks[cpos][0] + off)
+                yield conns[k], t, data[a:a + n]
+            return
+        for t, cpos, off, k in zip(time.tolist(), where.tolist(), offset.tolist(), which.tolist()):
             data, base = self._chunk_data(cpos)
-            at = base + off
-            while True:  # connection records may come first, as rosbags allows
-                end = at + 4 + u32(data, at)[0]
-                op, at = -1, at + 4
-                while at < end:  # the header's fields: only op is needed, the index gave the rest
-                    size = u32(data, at)[0]
-                    if data[at + 4:at + 7] == b"op=":
-                        op = data[at + 7]
-                    at += 4 + size
-                size = u32(data, end)[0]
-                at = end + 4
-                if op != _OP_CONNECTION:
-                    break
-                at += size
-            if op != _OP_MSG_DATA or at + size > len(data):
-                raise ValueError(f"no message data at offset {off} of the chunk at {cpos}, where the index points")
-            yield conns[k], t, data[at:at + size]
+            a, n = self._walk(data, cpos, off, base + off)
+            yield conns[k], t, data[a:a + n]
+
+    @staticmethod
+    def _walk(data, cpos: int, off: int, at: int) -> tuple[int, int]:
+        """Where the message data of the record at ``at`` starts, and its length, reading
+        its header field by field (connection records may come first, as rosbags allows)."""
+        u32 = _U32.unpack_from
+        while True:
+            end = at + 4 + u32(data, at)[0]
+            op, at = -1, at + 4
+            while at < end:  # the header's fields: only op is needed, the index gave the rest
+                size = u32(data, at)[0]
+                if data[at + 4:at + 7] == b"op=":
+                    op = data[at + 7]
+                at += 4 + size
+            size = u32(data, end)[0]
+            at = end + 4
+            if op != _OP_CONNECTION:
+                break
+            at += size
+        if op != _OP_MSG_DATA or at + size > len(data):
+            raise ValueError(f"no message data at offset {off} of the chunk at {cpos}, where the index points")
+        return at, size
 
     def deserialize(self, raw: bytes, msgtype: str):
         """The message ``raw`` decoded as ``msgtype``, with the definitions the bag holds
@@ -275,8 +297,41 @@ class Bag1Reader:
             return
         self.stack = None
         self._chunk = b""
+        self._u8 = None  # the file's bytes as an array hold the map open
         self._map.close()
         self._file.close()
+
+
+def _u32_at(u8: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """The little-endian uint32 at each position of ``at`` in the bytes ``u8``, as int64."""
+    b = u8[at[:, None] + np.arange(4)].astype(np.int64)
+    return b[:, 0] | (b[:, 1] << 8) | (b[:, 2] << 16) | (b[:, 3] << 24)
+
+
+def _message_spans(u8: np.ndarray, record: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For message data records at ``record`` (positions in the file), where each one's
+    data starts, its length, and whether that was read for sure: the header must be three
+    fields that fill it exactly (as rosbag writes them: time, conn, op, in any order), one
+    of them ``op=`` with the message data's code. Others are read field by field."""
+    n = len(u8)
+    ok = record + 8 <= n
+    rec = np.where(ok, record, 0)
+    header_end = rec + 4 + _u32_at(u8, rec)
+    at = rec + 4
+    op_ok = np.zeros(len(rec), dtype=bool)
+    for _ in range(3):
+        ok &= at + 8 <= header_end
+        at = np.where(ok, at, 0)
+        size = _u32_at(u8, at)
+        name = u8[(at + 4)[:, None] + np.arange(4)]
+        op_ok |= ok & (size == 4) & (name[:, 0] == ord("o")) & (name[:, 1] == ord("p")) & (name[:, 2] == ord("=")) & (
+            name[:, 3] == _OP_MSG_DATA)
+        at = at + 4 + size
+    ok &= op_ok & (at == header_end) & (header_end + 4 <= n)
+    header_end = np.where(ok, header_end, 0)
+    size = _u32_at(u8, header_end)
+    ok &= header_end + 4 + size <= n
+    return header_end + 4, size, ok
 
 
 def open_bag1(path: Path) -> Bag1Reader | None:
