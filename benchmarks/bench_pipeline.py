@@ -33,6 +33,7 @@ Peak resident memory of the benchmark process closes the output.
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import re
 import resource
@@ -234,6 +235,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     _one_core()
     config = load_config()
+    gc.freeze()  # as people-tracker run and the ROS 2 node do after start-up
     print("compiled kernels: " + (f"on (numba {compiled.numba_version()})" if compiled.ENABLED else
                                   "off, numpy only (install the [fast] extra, or PEOPLE_TRACKER_COMPILED is 0)"))
     print(f"{'pipeline':<44} {'scans/s':>8} {'p50 ms':>8} {'p99 ms':>8}  tracks/scan")

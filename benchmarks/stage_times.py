@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import gc
 import sys
 import time
 from collections import Counter
@@ -113,6 +114,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     _one_core()
     warm_up_kernels()
+    gc.freeze()  # as people-tracker run and the ROS 2 node do after start-up
     config = load_config()
     instrument(PeopleTracker.from_config(config))
     bag = DATA / "general_tracking_moving_1.bag"
