@@ -53,7 +53,7 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
             continue
         stamp = record.scan.stamp
         if sel.target is not None and sel.lost_since is None and any(
-                u.track_id == sel.target and stamp - u.last_update >= sel.coast_s for u in tracker._tracks):
+                u.track_id == sel.target and sel.coasting(stamp, u.last_update) for u in tracker._tracks):
             out[f"no target: the person's track has had no update for {sel.coast_s:g} s (reported lost)"] += 1
         elif any(d <= NEAR_M for d in dist.values()):
             if sel.target is None or sel.lost_since is None:

@@ -152,6 +152,11 @@ class TargetSelector:
         refs = [r for r in (self.velocity, self.sensor_velocity()) if r is not None]
         return not refs or min(float(np.hypot(*(velocity - r))) for r in refs) <= self._max_walk_change
 
+    def coasting(self, stamp: float, last_update: float) -> bool:
+        """Whether a track last updated at ``last_update`` (s) has coasted ``coast_s`` by
+        ``stamp`` (s): where the person is now is then a guess."""
+        return stamp - last_update >= self.coast_s
+
     def lost(self, stamp: float) -> None:
         """The target's track broke off (or was found on someone else) at ``stamp`` (s)."""
         if self.lost_since is None:

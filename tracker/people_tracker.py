@@ -1001,7 +1001,7 @@ class PeopleTracker:
                 sel.seen(stamp, q, t.velocity)
             elif t is None or not t.reported:
                 sel.lost(stamp)
-            elif stamp - t.last_update >= sel.coast_s:
+            elif sel.coasting(stamp, t.last_update):
                 # coasting, while a track is updated where the person should be: that one is them
                 if sel.only_one_near(stamp, here(u for u in self._tracks if u is not t and u.updated_now)) is not None:
                     t = self._retire(t)
@@ -1020,7 +1020,7 @@ class PeopleTracker:
         t = next(u for u in self._tracks if u.track_id == target) if target in reported else None  # ids are unique
         if t is not None and sel.expected(stamp) is None:
             sel.seen(stamp, reported[target], t.velocity)
-        if t is not None and stamp - t.last_update >= sel.coast_s:
+        if t is not None and sel.coasting(stamp, t.last_update):
             return None  # coasting: where the person is now is a guess; reported lost, not marked
         return target
 
