@@ -872,7 +872,9 @@ class PeopleTracker:
         xy = np.array([self._tracks[i].position for i in idx])
         d = pairwise_distances(xy, xy)
         out = set()
-        for a, b in zip(*np.nonzero(np.triu(d < sep, k=1))):
+        rows, cols = np.nonzero(d < sep)
+        upper = rows < cols  # each pair once, in np.triu's (row-major) order
+        for a, b in zip(rows[upper].tolist(), cols[upper].tolist()):
             ta, tb = self._tracks[idx[a]], self._tracks[idx[b]]
             if not (ta.still or tb.still) or idx[a] in out or idx[b] in out:
                 continue
