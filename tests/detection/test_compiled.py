@@ -113,14 +113,20 @@ def test_leg_scores_and_line_normals_agree_on_simulated_lasers(laser):
             assert normals.tobytes() == line_normals(scan.valid_points, 0.2).tobytes()
 
 
+def _places_around(laser: str, rng):
+    """Each simulated scan of ``laser`` with a random sensor pose and 60 places around it
+    (world frame; in view and not, near and far)."""
+    for scan in _simulated(LASERS[laser], seconds=2.0):
+        pose = Pose2D(*rng.uniform(-1, 1, 2), rng.uniform(-3, 3))
+        yield scan, pose, pose.transform_points(rng.uniform(-8, 8, (60, 2)))
+
+
 @pytest.mark.parametrize("laser", sorted(LASERS))
 def test_seen_through_agrees_on_simulated_lasers(laser):
     from people_tracker.detection.free_space import seen_through
     rng = np.random.default_rng(12)
     seen = 0
-    for scan in _simulated(LASERS[laser], seconds=2.0):
-        pose = Pose2D(*rng.uniform(-1, 1, 2), rng.uniform(-3, 3))
-        places = pose.transform_points(rng.uniform(-8, 8, (60, 2)))  # in view and not, near and far
+    for scan, pose, places in _places_around(laser, rng):
         moving = rng.random(scan.n_beams) < 0.3
         for margin, reach, mask in ((0.1, np.inf, None), (0.3, 3.0, moving), (0.0, 0.0, moving)):
             fast = seen_through(places, scan, pose, margin, mask, reach)
@@ -134,11 +140,8 @@ def test_seen_through_agrees_on_simulated_lasers(laser):
 @pytest.mark.parametrize("laser", sorted(LASERS))
 def test_place_visibility_agrees_on_simulated_lasers(laser):
     from people_tracker.detection.free_space import place_visibility
-    rng = np.random.default_rng(11)
     codes = set()
-    for scan in _simulated(LASERS[laser], seconds=2.0):
-        pose = Pose2D(*rng.uniform(-1, 1, 2), rng.uniform(-3, 3))
-        places = pose.transform_points(rng.uniform(-8, 8, (60, 2)))  # in view and not, near and far
+    for scan, pose, places in _places_around(laser, np.random.default_rng(11)):
         for radius, reach in ((0.25, np.inf), (0.4, 3.0), (0.1, 0.0)):
             fast = place_visibility(places, scan, pose, radius, reach)
             with compiled.numpy_only():

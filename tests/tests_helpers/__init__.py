@@ -32,3 +32,12 @@ def assert_one_line_error(proc: subprocess.CompletedProcess, *words: str, before
         assert w in lines[0], lines[0]
     if before_work:
         assert proc.stdout == ""
+
+
+def simulated_corridor(folder: Path, fmt: str, seconds: float = 2.0) -> Path:
+    """The simulated ``corridor`` scene (odometry, /tf and /tf_static) written by
+    ``people-tracker simulate`` as a ROS 1 bag (``fmt`` "ros1") or a ROS 2 bag folder."""
+    out = folder / ("corr.bag" if fmt == "ros1" else "corr")
+    proc = run_cli("simulate", "corridor", "--output", str(out), "--duration", str(seconds), "--format", fmt)
+    assert proc.returncode == 0, proc.stderr
+    return out

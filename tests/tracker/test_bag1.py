@@ -70,11 +70,9 @@ def test_the_real_recordings_are_there():
 @pytest.mark.parametrize("compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4],
                          ids=["none", "bz2", "lz4"])
 def test_the_fast_reader_reads_compressed_chunks_as_rosbags_does(tmp_path, compression):
-    from tests_helpers import run_cli
+    from tests_helpers import simulated_corridor
 
-    plain = tmp_path / "corr.bag"
-    proc = run_cli("simulate", "corridor", "--output", str(plain), "--duration", "3", "--format", "ros1")
-    assert proc.returncode == 0, proc.stderr
+    plain = simulated_corridor(tmp_path, "ros1", seconds=3.0)
     out = tmp_path / "copy.bag"
     writer = Writer(out)
     writer.chunk_threshold = 20_000  # several chunks, so that the merge across chunks is tested
@@ -142,12 +140,9 @@ def _transforms_both_ways(path) -> tuple[list, int]:
 
 @pytest.mark.parametrize("fmt", ["mcap", "sqlite3", "ros1"])
 def test_tf_read_in_place_is_the_deserialized_tf(tmp_path, fmt):
-    from tests_helpers import run_cli
+    from tests_helpers import simulated_corridor
 
-    out = tmp_path / ("corr.bag" if fmt == "ros1" else "corr")
-    proc = run_cli("simulate", "corridor", "--output", str(out), "--duration", "2", "--format", fmt)
-    assert proc.returncode == 0, proc.stderr
-    pairs, odometry = _transforms_both_ways(out)
+    pairs, odometry = _transforms_both_ways(simulated_corridor(tmp_path, fmt))
     assert len(pairs) > 10 and odometry > 10
     assert all(fast == full for fast, full in pairs)
 

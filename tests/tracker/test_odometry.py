@@ -90,12 +90,9 @@ def _odometry_poses_both_ways(path):
 
 @pytest.mark.parametrize("fmt", ["mcap", "sqlite3", "ros1"])
 def test_odometry_pose_read_in_place_is_the_deserialized_one(tmp_path, fmt):
-    from tests_helpers import run_cli
+    from tests_helpers import simulated_corridor
 
-    out = tmp_path / ("corr.bag" if fmt == "ros1" else "corr")
-    proc = run_cli("simulate", "corridor", "--output", str(out), "--duration", "2", "--format", fmt)
-    assert proc.returncode == 0, proc.stderr
-    pairs = _odometry_poses_both_ways(out)
+    pairs = _odometry_poses_both_ways(simulated_corridor(tmp_path, fmt))
     assert len(pairs) > 10 and len({full for _, full in pairs}) > 10  # the robot drives: poses differ
     assert all(fast == full for fast, full in pairs)
 
