@@ -39,7 +39,7 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
     local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
     dist = np.hypot(local[:, 0], local[:, 1])
     if compiled.on:  # the rest, compiled
-        return _seen_kernel(local, dist, scan.ranges, scan.no_return, scan.angle_min, scan.angle_increment,
+        return _seen_through_kernel(local, dist, scan.ranges, scan.no_return, scan.angle_min, scan.angle_increment,
                             scan.range_min, margin_m, moving is not None,
                             moving if moving is not None else scan.no_return, no_return_free_m)
     beam = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
@@ -58,8 +58,8 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
     return inside & free
 
 
-def _seen_loop(local, dist, ranges, no_return, angle_min, angle_increment, range_min, margin_m, use_moving, moving,
-               no_return_free_m):
+def _seen_through_loop(local, dist, ranges, no_return, angle_min, angle_increment, range_min, margin_m, use_moving,
+                       moving, no_return_free_m):
     """:func:`seen_through` from the points in the sensor frame on, one point at a time
     (compiled by numba; the numpy code is the reference)."""
     n_beams = len(ranges)
@@ -77,7 +77,7 @@ def _seen_loop(local, dist, ranges, no_return, angle_min, angle_increment, range
     return out
 
 
-_seen_kernel = njit(_seen_loop)
+_seen_through_kernel = njit(_seen_through_loop)
 
 UNSEEN, OCCLUDED, OCCUPIED, SEEN_THROUGH = 0, 1, 2, 3
 

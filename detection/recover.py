@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from people_tracker.detection.labels import MOVING, OCCLUDED, STATIC
-from people_tracker.detection.segments import Segment
+from people_tracker.detection.segments import Segment, runs_of
 from people_tracker.models import compiled
 
 
@@ -126,12 +126,6 @@ def recover_from_bounds(bounds: np.ndarray, labels: np.ndarray, points: np.ndarr
                                                 single_object_max_o)
     return [Segment(a, b, lab, _SETS[mask]) for a, b, lab, mask in
             zip(starts.tolist(), stops.tolist(), labs.tolist(), sets.tolist())]
-
-
-def runs_of(bounds: np.ndarray, labels: np.ndarray) -> list[Segment]:
-    """The runs ``bounds`` delimits as Segments, each labelled as its first reading."""
-    starts, stops = bounds[:-1].tolist(), bounds[1:].tolist()
-    return [Segment(a, b, lab, (lab,)) for a, b, lab in zip(starts, stops, labels[bounds[:-1]].tolist())]
 
 
 # a segment's sets as a bit mask (bit label + 1, so the noise label -1 is bit 0), and back

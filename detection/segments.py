@@ -42,7 +42,12 @@ def split_runs(labels: np.ndarray, points: np.ndarray, gap_threshold: np.ndarray
     """
     if len(labels) == 0:
         return []
-    bounds = run_bounds(points, gap_threshold, labels)
+    return runs_of(run_bounds(points, gap_threshold, labels), labels)
+
+
+def runs_of(bounds: np.ndarray, labels: np.ndarray) -> list[Segment]:
+    """The runs ``bounds`` delimits (see :func:`run_bounds`) as Segments, each labelled as
+    its first reading."""
     starts, stops, first = bounds[:-1].tolist(), bounds[1:].tolist(), labels[bounds[:-1]].tolist()  # Python ints
     return [Segment(a, b, lab, (lab,)) for a, b, lab in zip(starts, stops, first)]
 

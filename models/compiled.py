@@ -97,8 +97,9 @@ def _numpy_trig_is_the_c_librarys() -> bool:
                 and np.array_equal(np.sin(x), [math.sin(v) for v in x]))
 
 
-# whether a kernel may compute what numpy's cos and sin would (else numpy does it)
-trig_is_numpys = _numpy_trig_is_the_c_librarys()
+# whether a kernel may compute what numpy's cos and sin would (else numpy does it); only
+# the kernels ask, so it is checked only when they are there
+trig_is_numpys = ENABLED and _numpy_trig_is_the_c_librarys()
 
 
 KERNELS: list = []  # every kernel the pipeline calls (not the helpers they call), for the warm-up's test

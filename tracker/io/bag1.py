@@ -171,15 +171,18 @@ class Bag1Reader:
                 entries = np.frombuffer(m[start:start + size], dtype=_INDEX_ENTRY)
                 parts[conn].append((entries, cpos))
                 pos = after
-        self._index: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        # per connection: each message's bag time (ns), chunk, offset in the chunk's records,
+        # and where those records start in the file (the record's place, for uncompressed chunks)
+        self._index: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
         for conn, chunks in parts.items():
             if chunks:
                 time = np.concatenate([e["sec"].astype(np.int64) * 10**9 + e["nsec"] for e, _ in chunks])
                 where = np.concatenate([np.full(len(e), cpos, dtype=np.int64) for e, cpos in chunks])
                 offset = np.concatenate([e["offset"].astype(np.int64) for e, _ in chunks])
+                base = np.concatenate([np.full(len(e), self._chunks[cpos][0], dtype=np.int64) for e, cpos in chunks])
             else:
-                time = where = offset = np.zeros(0, dtype=np.int64)
-            self._index[conn] = (time, where, offset)
+                time = where = offset = base = np.zeros(0, dtype=np.int64)
+            self._index[conn] = (time, where, offset, base)
         self.connections = [Connection(c.id, c.topic, c.msgtype, c.msgdef, c.digest, len(self._index[c.id][0]),
                                         c.ext, c.owner) for c in self.connections]
 
@@ -225,21 +228,15 @@ class Bag1Reader:
             raise ValueError("the bag is closed")
         conns = list(connections) or self.connections
         index = [self._index[c.id] for c in conns]
-        time = np.concatenate([t for t, _, _ in index])
-        where = np.concatenate([w for _, w, _ in index])
-        offset = np.concatenate([o for _, _, o in index])
-        which = np.concatenate([np.full(len(t), k) for k, (t, _, _) in enumerate(index)])
+        time, where, offset, base = (np.concatenate([part[i] for part in index]) for i in range(4))
+        which = np.concatenate([np.full(len(part[0]), k) for k, part in enumerate(index)])
         order = np.lexsort((offset, where, time))
-        time, where, offset, which = time[order], where[order], offset[order], which[order]
-        lo = 0 if start is None else int(np.searchsorted(time, start, side="left"))
-        hi = len(time) if stop is None else int(np.searchsorted(time, stop, side="left"))
-        time, where, offset, which = time[lo:hi], where[lo:hi], offset[lo:hi], which[lo:hi]
+        lo = 0 if start is None else int(np.searchsorted(time[order], start, side="left"))
+        hi = len(time) if stop is None else int(np.searchsorted(time[order], stop, side="left"))
+        order = order[lo:hi]
+        time, where, offset, base, which = time[order], where[order], offset[order], base[order], which[order]
         if self._u8 is not None and len(time):  # uncompressed: every header read at once
-            chunk_pos = np.fromiter(self._chunks, dtype=np.int64, count=len(self._chunks))
-            chunk_data = np.array([start for start, _, _ in self._chunks.values()], dtype=np.int64)
-            order = np.argsort(chunk_pos)
-            starts = chunk_data[order][np.searchsorted(chunk_pos[order], where)]  # each message's chunk data
-            at, size, ok = _message_spans(self._u8, starts + offset)
+            at, size, ok = _message_spans(self._u8, base + offset)
             data = self._map
             for t, cpos, off, k, a, n, good in zip(time.tolist(), where.tolist(), offset.tolist(), which.tolist(),
                                                    at.tolist(), size.tolist(), ok.tolist()):
@@ -248,29 +245,23 @@ class Bag1Reader:
                 yield conns[k], t, data[a:a + n]
             return
         for t, cpos, off, k in zip(time.tolist(), where.tolist(), offset.tolist(), which.tolist()):
-            data, base = self._chunk_data(cpos)
-            a, n = self._walk(data, cpos, off, base + off)
+            data, chunk_base = self._chunk_data(cpos)
+            a, n = self._walk(data, cpos, off, chunk_base + off)
             yield conns[k], t, data[a:a + n]
 
     @staticmethod
     def _walk(data, cpos: int, off: int, at: int) -> tuple[int, int]:
         """Where the message data of the record at ``at`` starts, and its length, reading
         its header field by field (connection records may come first, as rosbags allows)."""
-        u32 = _U32.unpack_from
         while True:
-            end = at + 4 + u32(data, at)[0]
-            op, at = -1, at + 4
-            while at < end:  # the header's fields: only op is needed, the index gave the rest
-                size = u32(data, at)[0]
-                if data[at + 4:at + 7] == b"op=":
-                    op = data[at + 7]
-                at += 4 + size
-            size = u32(data, end)[0]
+            end = at + 4 + _U32.unpack_from(data, at)[0]
+            op = _fields(data[at + 4:end]).get(b"op")  # the index gave the rest
+            size = _U32.unpack_from(data, end)[0]
             at = end + 4
-            if op != _OP_CONNECTION:
+            if op != bytes([_OP_CONNECTION]):
                 break
             at += size
-        if op != _OP_MSG_DATA or at + size > len(data):
+        if op != bytes([_OP_MSG_DATA]) or at + size > len(data):
             raise ValueError(f"no message data at offset {off} of the chunk at {cpos}, where the index points")
         return at, size
 
