@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
+
+from people_tracker.models.cached import cached_property
 
 TWO_PI = 2.0 * np.pi
 
