@@ -7,6 +7,7 @@ number of scans from the stamps) and returns per-beam labels and the moving obje
 
 from __future__ import annotations
 
+import functools
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -237,6 +238,27 @@ def _label_pair_loop(valid_c, pts_c, ranges_c, res_c, angle_min, angle_increment
     return labels
 
 
+def _nearest_loop(stamps, targets):
+    """For each of ``targets`` (s), the index of the first of ``stamps`` (s) nearest it:
+    ``np.argmin(np.abs(stamps - target))`` for each, as one loop (compiled by numba)."""
+    out = np.zeros(len(targets), np.int64)
+    for k in range(len(targets)):
+        best_gap = abs(stamps[0] - targets[k])
+        for i in range(1, len(stamps)):
+            gap = abs(stamps[i] - targets[k])
+            if gap < best_gap:  # np.argmin: the first of equal ones
+                out[k], best_gap = i, gap
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def _as_array(values: tuple[float, ...]) -> np.ndarray:
+    """A parameter tuple (seconds) as a read-only float array, made once per tuple."""
+    out = np.asarray(values, dtype=float)
+    out.setflags(write=False)
+    return out
+
+
 def _lookback_loop(stamps, posed, stamp, lookbacks, need_pose):
     """:meth:`MovingObjectDetector._lookback`'s choices as one loop (compiled by numba): for
     each lookback, the index of the kept scan it picks, -1 for none."""
@@ -279,7 +301,7 @@ def _seen_loop(q, thr, c, s, x, y, points, geometry, shape, start, order, seen):
 def combine(pairs: list[np.ndarray]) -> np.ndarray:
     """One label per reading from several comparisons: moving in any → M; else occluded in
     any → O; else static in any → A; else N."""
-    stack = np.stack(pairs)
+    stack = np.array(pairs)  # np.stack's result, made faster
     if compiled.on:
         return _combine_kernel(stack)
     out = pairs[0].copy()
@@ -307,11 +329,68 @@ def _combine_loop(stack):
     return out
 
 
-def _share_per_span(flags: np.ndarray, spans: list[tuple[int, int]]) -> np.ndarray:
+def _share_per_span(flags: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     """For readings laid out span after span (``flags``: one bool per reading of the spans,
-    in order), the share of each span's readings that are flagged."""
-    sizes = np.array([b - a for a, b in spans])
+    in order; ``sizes``: each span's count, at least 1), the share of each span's readings
+    that are flagged."""
+    if compiled.on:
+        return _share_kernel(flags, sizes)
     return np.add.reduceat(flags.astype(float), np.concatenate([[0], np.cumsum(sizes)[:-1]])) / sizes
+
+
+def _isolated_loop(bounds, run_labels, points, ranges, gap, min_points, max_extent):
+    """The O runs of at least ``min_points`` readings (``bounds``: the runs' first readings
+    and one past the last; ``run_labels``: each valid reading's label) that
+    :func:`~people_tracker.detection.recover.isolated_occluded` keeps, as one loop (compiled by
+    numba; its tests in its order): their first readings and one past their last."""
+    n = len(points)
+    starts, stops = np.empty(len(bounds), np.int64), np.empty(len(bounds), np.int64)
+    k = 0
+    for r in range(len(bounds) - 1):
+        a, b = bounds[r], bounds[r + 1]
+        if run_labels[a] != OCCLUDED or b - a < min_points:
+            continue
+        if np.hypot(points[b - 1, 0] - points[a, 0], points[b - 1, 1] - points[a, 1]) > max_extent:
+            continue
+        left_ok = a == 0 or ranges[a - 1] > ranges[a] + gap[a]
+        right_ok = b == n or ranges[b] > ranges[b - 1] + gap[b - 1]
+        if left_ok and right_ok:
+            starts[k], stops[k] = a, b
+            k += 1
+    return starts[:k], stops[:k]
+
+
+def _share_loop(flags, sizes):
+    """:func:`_share_per_span` as one loop (compiled by numba): the count over the size, as
+    numpy's sum of ones and zeros (exact) over it."""
+    out = np.empty(len(sizes))
+    i = 0
+    for k in range(len(sizes)):
+        count = 0
+        for _ in range(sizes[k]):
+            count += flags[i]
+            i += 1
+        out[k] = count / sizes[k]
+    return out
+
+
+def _span_readings(starts: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """The indices of the readings of spans (``starts``, ``sizes``), span after span:
+    ``np.concatenate([np.arange(a, a + n) for a, n in zip(starts, sizes)])``."""
+    if compiled.on:
+        return _span_readings_kernel(starts, sizes)
+    return np.concatenate([np.arange(a, a + n) for a, n in zip(starts.tolist(), sizes.tolist())])
+
+
+def _span_readings_loop(starts, sizes):
+    """:func:`_span_readings` as one loop (compiled by numba)."""
+    out = np.empty(sizes.sum(), np.int64)
+    i = 0
+    for k in range(len(starts)):
+        for j in range(sizes[k]):
+            out[i] = starts[k] + j
+            i += 1
+    return out
 
 
 class MovingObjectDetector:
@@ -345,10 +424,17 @@ class MovingObjectDetector:
             out.append((best.scan, best.pose, moving))
         return out
 
-    def _index_history(self) -> None:
-        """The kept scans' stamps (s) and whether each has a pose, as arrays for the lookbacks."""
-        self._stamps = np.array([p.scan.stamp for p in self._history], dtype=float)
-        self._posed = np.array([p.pose is not None for p in self._history], dtype=bool)
+    def _index_history(self, dropped: int | None = None) -> None:
+        """The kept scans' stamps (s) and whether each has a pose, as arrays for the lookbacks:
+        built anew (``dropped`` None), or moved on by one scan appended after ``dropped``
+        scans left the front."""
+        if dropped is None:
+            self._stamps = np.array([p.scan.stamp for p in self._history], dtype=float)
+            self._posed = np.array([p.pose is not None for p in self._history], dtype=bool)
+            return
+        last = self._history[-1]
+        self._stamps = np.append(self._stamps[dropped:], last.scan.stamp)
+        self._posed = np.append(self._posed[dropped:], last.pose is not None)
 
     def _lookback(self, stamp: float, lookbacks_s: tuple[float, ...], need_pose: bool) -> list[_Past]:
         """For each lookback, the kept scan nearest ``stamp - lookback`` and at least half
@@ -357,11 +443,12 @@ class MovingObjectDetector:
         if not len(self._stamps):
             return out
         if compiled.on:  # the choices below as one compiled loop
-            for k in _lookback_kernel(self._stamps, self._posed, float(stamp), np.asarray(lookbacks_s, dtype=float),
-                                      need_pose):
-                if k >= 0 and all(self._history[k] is not o for o in out):
-                    out.append(self._history[k])
-            return out
+            chosen: list[int] = []
+            for k in _lookback_kernel(self._stamps, self._posed, float(stamp), _as_array(tuple(lookbacks_s)),
+                                      need_pose).tolist():
+                if k >= 0 and k not in chosen:
+                    chosen.append(k)
+            return [self._history[k] for k in chosen]
         age = stamp - self._stamps
         for lookback in lookbacks_s:
             ok = age >= 0.5 * lookback
@@ -391,8 +478,13 @@ class MovingObjectDetector:
         memory = self._lookback(scan.stamp, p.static_memory_s, need_pose=pose is not None)
         if not memory:
             return keep
+        # the current frame seen from each earlier one
+        rels = [past.pose.between(pose) if pose is not None else Pose2D() for past in memory]
+        starts = np.array([a for a, _ in spans], dtype=np.int64)
+        sizes = np.array([b - a for a, b in spans], dtype=np.int64)
+        idx_all = _span_readings(starts, sizes)
         if p.drop_carried and pose is not None:
-            keep &= ~self._carried(scan, pose, spans, pts, ranges, memory)
+            keep &= ~self._carried(scan, pts[idx_all], ranges[idx_all], sizes, memory, rels)
         test = np.arange(len(spans))
         near = np.zeros(len(spans), dtype=bool)
         if people is not None and len(people):
@@ -402,17 +494,16 @@ class MovingObjectDetector:
             test = test[~exempt]
         if not len(test):
             return keep
-        idx = np.concatenate([np.arange(*spans[k]) for k in test])
+        idx = idx_all if len(test) == len(spans) else _span_readings(starts[test], sizes[test])
         # near a person, only what was seen still a second ago counts: in a crowd someone
         # else walked there
-        still_only = np.repeat(near[test], [spans[k][1] - spans[k][0] for k in test])
+        still_only = np.repeat(near[test], sizes[test])
         q = pts[idx]
         thr = range_threshold(ranges[idx], scan.resolution, p.static_memory_k * p.k_closest,
                               p.static_memory_k * p.closest_floor_m)
         seen = np.zeros(len(q), dtype=np.int64)
         any_still_only = bool(still_only.any())
-        for past in memory:
-            rel = past.pose.between(pose) if pose is not None else Pose2D()  # current frame seen from the past one
+        for past, rel in zip(memory, rels):
             if not any_still_only:  # whether a reading was there, not which
                 grid = past.tree.grid
                 if compiled.on and grid is not None:
@@ -428,22 +519,21 @@ class MovingObjectDetector:
                 beam = past.scan.valid_index[np.minimum(j, past.scan.n_valid - 1)]
                 hit &= ~still_only | past.static[beam]
             seen += hit
-        share = _share_per_span(seen >= p.static_memory_min_scans, [spans[k] for k in test])
+        share = _share_per_span(seen >= p.static_memory_min_scans, sizes[test])
         keep[test[share >= p.static_memory_share]] = False
         return keep
 
-    def _carried(self, scan: Scan, pose: Pose2D, spans: list[tuple[int, int]], pts: np.ndarray,
-                 ranges: np.ndarray, memory: list[_Past]) -> np.ndarray:
-        """Which objects ride with the sensor (see ``drop_carried`` in :class:`DetectorParams`)."""
+    def _carried(self, scan: Scan, q: np.ndarray, ranges: np.ndarray, sizes: np.ndarray, memory: list[_Past],
+                 rels: list[Pose2D]) -> np.ndarray:
+        """Which objects ride with the sensor (see ``drop_carried`` in :class:`DetectorParams`):
+        ``q`` their readings (sensor frame, metres) and ``ranges`` (m), object after object
+        (``sizes`` readings each); ``rels``, the current frame seen from each ``memory`` scan."""
         p = self.params
-        idx = np.concatenate([np.arange(a, b) for a, b in spans])
-        q = pts[idx]
-        thr = range_threshold(ranges[idx], scan.resolution, p.k_closest, p.closest_floor_m)
+        thr = range_threshold(ranges, scan.resolution, p.k_closest, p.closest_floor_m)
         rigid = np.ones(len(q), dtype=bool)
-        for past in memory:
+        for past, rel in zip(memory, rels):
             if past.pose is None:
-                return np.zeros(len(spans), dtype=bool)
-            rel = past.pose.between(pose)
+                return np.zeros(len(sizes), dtype=bool)
             grid = past.tree.grid
             if compiled.on and grid is not None and len(q):  # the three lines below as one compiled loop
                 _carried_kernel(q, thr, *rel._cos_sin, rel.x, rel.y, *grid, rigid)
@@ -451,16 +541,19 @@ class MovingObjectDetector:
             moved = rel.transform_points(q) - q
             shift = np.hypot(moved[:, 0], moved[:, 1])
             rigid &= past.tree.within(q, thr, inclusive=True) & (shift > 2.0 * thr)
-        return _share_per_span(rigid, spans) >= 0.5
+        return _share_per_span(rigid, sizes) >= 0.5
 
     def _earlier(self, stamp: float) -> list[_Past]:
         """For each Δt, the stored scan whose stamp is nearest ``stamp - Δt`` (at least one scan back)."""
         if not self._history:
             return []
-        stamps = self._stamps
+        targets = stamp - _as_array(tuple(self.params.compare_dt_s))
+        if compiled.on:  # np.argmin of each below, in one compiled loop
+            picks = _nearest_kernel(self._stamps, targets).tolist()
+        else:
+            picks = [int(np.argmin(np.abs(self._stamps - t))) for t in targets]
         chosen = []
-        for dt in self.params.compare_dt_s:
-            k = int(np.argmin(np.abs(stamps - (stamp - dt))))
+        for k in picks:
             past = self._history[k]
             if all(past is not c for c in chosen):
                 chosen.append(past)
@@ -486,9 +579,11 @@ class MovingObjectDetector:
         tree = tree if tree is not None else _tree(scan)
         current = _Past(scan, pose, tree)
         self._history.append(current)
-        while self._history and self._history[0].scan.stamp < scan.stamp - self._keep_s:
+        dropped = 0
+        while self._history[0].scan.stamp < scan.stamp - self._keep_s:
             self._history.popleft()
-        self._index_history()
+            dropped += 1
+        self._index_history(dropped)
         if not earlier:
             return Detection(np.where(scan.valid, OUT_OF_VIEW, INVALID).astype(np.int8), [], ())
         pairs = []
@@ -509,11 +604,18 @@ class MovingObjectDetector:
                                     p.max_object_size_m, p.single_object_max_o)
         if p.isolated_o_objects:  # objects moving away, whatever else moves (extends Algorithm 3)
             taken = {(r.start, r.stop) for r in found}
-            first = bounds[:-1]
-            big_o = np.flatnonzero((run_labels[first] == OCCLUDED) & (np.diff(bounds) >= p.min_object_points))
-            runs = [Segment(a, b, OCCLUDED, (OCCLUDED,)) for a, b in zip(first[big_o].tolist(), bounds[big_o + 1].tolist())]
-            found += [r for r in isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
-                                                   p.max_object_size_m) if (r.start, r.stop) not in taken]
+            if compiled.on and len(pts):  # the runs and isolated_occluded below as one compiled loop
+                starts, stops = _isolated_kernel(bounds, run_labels, pts, scan.ranges[valid], gap, p.min_object_points,
+                                                 p.max_object_size_m)
+                isolated = [Segment(a, b, OCCLUDED, (OCCLUDED,)) for a, b in zip(starts.tolist(), stops.tolist())]
+            else:
+                first = bounds[:-1]
+                big_o = np.flatnonzero((run_labels[first] == OCCLUDED) & (np.diff(bounds) >= p.min_object_points))
+                runs = [Segment(a, b, OCCLUDED, (OCCLUDED,))
+                        for a, b in zip(first[big_o].tolist(), bounds[big_o + 1].tolist())]
+                isolated = isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
+                                             p.max_object_size_m)
+            found += [r for r in isolated if (r.start, r.stop) not in taken]
         found = [seg for seg in found if seg.size >= p.min_object_points]
         # static things that flicker are not moving (extension, see DetectorParams)
         keep = self._static_memory(scan, pose, [(seg.start, seg.stop) for seg in found], pts,
@@ -538,5 +640,9 @@ def v_min(params: DetectorParams, resolution: float, ranges_m=(1.0, 3.0, 5.0)) -
 _label_pair_kernel = compiled.njit(_label_pair_loop)
 _combine_kernel = compiled.njit(_combine_loop)
 _lookback_kernel = compiled.njit(_lookback_loop)
+_nearest_kernel = compiled.njit(_nearest_loop)
+_share_kernel = compiled.njit(_share_loop)
+_isolated_kernel = compiled.njit(_isolated_loop)
+_span_readings_kernel = compiled.njit(_span_readings_loop)
 _carried_kernel = compiled.njit(_carried_loop)
 _seen_kernel = compiled.njit(_seen_loop)
