@@ -54,18 +54,21 @@ class Pose2D:
         return self.compose(other)
 
     def inverse(self) -> "Pose2D":
-        """b_T_a from self = a_T_b."""
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        # t_ba = -R_abᵀ t_ab
-        return _pose(-(c * self.x + s * self.y), -(-s * self.x + c * self.y), _wrap(-self.yaw))
+        """b_T_a from self = a_T_b (worked out once per pose: poses are immutable)."""
+        inv = self.__dict__.get("_inverse")
+        if inv is None:
+            c, s = math.cos(self.yaw), math.sin(self.yaw)
+            # t_ba = -R_abᵀ t_ab
+            inv = self.__dict__["_inverse"] = _pose(-(c * self.x + s * self.y), -(-s * self.x + c * self.y),
+                                                    _wrap(-self.yaw))
+        return inv
 
     def between(self, other: "Pose2D") -> "Pose2D":
         """Relative pose self⁻¹ ∘ other: where ``other`` is, seen from ``self``
-        (:meth:`inverse` then :meth:`compose`, their arithmetic written out in one call)."""
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        x, y, yaw = -(c * self.x + s * self.y), -(-s * self.x + c * self.y), _wrap(-self.yaw)  # the inverse
-        c, s = math.cos(yaw), math.sin(yaw)
-        return _pose(x + c * other.x - s * other.y, y + s * other.x + c * other.y, _wrap(yaw + other.yaw))
+        (:meth:`compose` written out, with the inverse's cached cosine and sine)."""
+        inv = self.inverse()
+        c, s = inv._cos_sin
+        return _pose(inv.x + c * other.x - s * other.y, inv.y + s * other.x + c * other.y, _wrap(inv.yaw + other.yaw))
 
     @cached_property
     def _cos_sin(self) -> tuple[float, float]:
