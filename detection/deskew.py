@@ -72,15 +72,16 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
         increment = scan.angle_increment
     if compiled.on:  # the rest as one compiled loop, the same arithmetic
         raw_bearings = scan.bearings if scan.bearings is not None else np.zeros(0)
-        out, source, bearings, valid, points = _deskew_kernel(
+        out, source, bearings, valid, no_return, points = _deskew_kernel(
             scan.ranges, raw_bearings, scan.bearings is not None, motion.x, motion.y, motion.yaw, scan.angle_min,
             scan.angle_increment, increment, scan.range_min, scan.range_max, compiled.trig_is_numpys)
         new = Scan(out, scan.angle_min, increment, scan.range_min, scan.range_max, scan.stamp,
                    scan.frame_id, scan.time_increment, bearings)
         # what the new scan's properties would compute, computed in the loop (the points
-        # only where the C library's cos and sin are numpy's): the written beams are its valid ones
+        # only where the C library's cos and sin are numpy's): the written beams are its valid
+        # ones, the beams left inf its lines of sight with no return
         index = np.flatnonzero(valid)
-        for name, value in (("valid", valid), ("valid_index", index)) + (
+        for name, value in (("valid", valid), ("valid_index", index), ("no_return", no_return)) + (
                 (("points", points), ("valid_points", points[index])) if compiled.trig_is_numpys else ()):
             value.setflags(write=False)
             new.__dict__[name] = value  # functools.cached_property's place for it
@@ -115,7 +116,7 @@ def _deskew_loop(ranges, raw_bearings, has_bearings, mx, my, myaw, angle_min, ra
     """:func:`deskew_with_source` from its new grid on, for the sweep's motion (mx, my,
     myaw) in the first beam's frame, as one loop (compiled by numba; the numpy code above is
     the reference): the new ranges, the source beams and the bearings; and the new scan's
-    valid mask and, if ``with_points``, its :attr:`Scan.points` (else nan)."""
+    valid and no-return masks and, if ``with_points``, its :attr:`Scan.points` (else nan)."""
     n = len(ranges)
     out = np.empty(n)
     for i in range(n):  # Scan.no_return of the raw scan: inf, or at or beyond range_max
@@ -145,13 +146,16 @@ def _deskew_loop(ranges, raw_bearings, has_bearings, mx, my, myaw, angle_min, ra
             source[b] = i
             bearings[b] = bearing
     valid = source >= 0
+    no_return = np.zeros(n, np.bool_)
+    for b in range(n):  # Scan.no_return of the new scan: a written reading lies below range_max
+        no_return[b] = np.isinf(out[b]) and out[b] > 0
     points = np.full((n, 2), np.nan)
     if with_points:
         for b in range(n):  # Scan.points: the range (nan where not valid) times cos and sin
             r = out[b] if valid[b] else np.nan
             points[b, 0] = r * np.cos(bearings[b])
             points[b, 1] = r * np.sin(bearings[b])
-    return out, source, bearings, valid, points
+    return out, source, bearings, valid, no_return, points
 
 
 _deskew_kernel = njit(_deskew_loop)

@@ -93,7 +93,7 @@ def test_deskew_agrees_on_simulated_lasers(laser):
         assert fast.ranges.tobytes() == ref.ranges.tobytes() and fast.bearings.tobytes() == ref.bearings.tobytes()
         assert fast.angle_increment == ref.angle_increment
         # the properties the loop filled in are what the scan would compute
-        seeded = {"valid", "valid_index"} | ({"points", "valid_points"} if compiled.trig_is_numpys else set())
+        seeded = {"valid", "valid_index", "no_return"} | ({"points", "valid_points"} if compiled.trig_is_numpys else set())
         assert seeded <= set(vars(fast))
         for name in seeded:
             assert getattr(fast, name).tobytes() == getattr(ref, name).tobytes(), name
