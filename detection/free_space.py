@@ -97,14 +97,14 @@ def place_visibility(points_world: np.ndarray, scan: Scan, pose: Pose2D, radius_
     points_world : ndarray, shape (k, 2)
         Places in the world frame, metres.
     """
-    out = np.full(len(points_world), UNSEEN, dtype=np.int8)
     if len(points_world) == 0:
-        return out
+        return np.full(0, UNSEEN, dtype=np.int8)
     local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
     dist = np.hypot(local[:, 0], local[:, 1])
     if compiled.on:  # the loop below, compiled
         return _visibility_kernel(local, dist, scan.ranges, scan.valid, scan.no_return, scan.angle_min,
                                   scan.angle_increment, radius_m, no_return_free_m)
+    out = np.full(len(points_world), UNSEEN, dtype=np.int8)
     centre = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
     inc = abs(scan.angle_increment)
     for k in np.flatnonzero((centre >= 0) & (dist > radius_m)):

@@ -72,6 +72,23 @@ def run_bounds(points: np.ndarray, gap_threshold: np.ndarray, labels: np.ndarray
     return np.concatenate([[0], np.flatnonzero(cut) + 1, [n]])
 
 
+def segment_of_readings(bounds: np.ndarray) -> np.ndarray:
+    """The run of each reading, from :func:`run_bounds`' ``bounds``:
+    ``np.repeat(np.arange(len(bounds) - 1), np.diff(bounds))`` (int64)."""
+    if compiled.on and len(bounds):
+        return _segment_of_kernel(np.ascontiguousarray(bounds, dtype=np.int64))
+    return np.repeat(np.arange(len(bounds) - 1), np.diff(bounds))
+
+
+def _segment_of_loop(bounds):
+    """:func:`segment_of_readings` as one loop (compiled by numba)."""
+    out = np.empty(bounds[-1] - bounds[0], np.int64)
+    for k in range(len(bounds) - 1):
+        for i in range(bounds[k], bounds[k + 1]):
+            out[i - bounds[0]] = k
+    return out
+
+
 def _run_bounds_loop(points, gap_threshold, labels, by_label):
     """:func:`run_bounds` (n >= 1) as one loop: the same comparisons, in int64 as numpy's
     concatenation gives them."""
@@ -123,3 +140,4 @@ def _means_chords_loop(pts, offsets):
 
 _means_chords_kernel = compiled.njit(_means_chords_loop)
 _run_bounds_kernel = compiled.njit(_run_bounds_loop)
+_segment_of_kernel = compiled.njit(_segment_of_loop)

@@ -144,6 +144,10 @@ class Existence:
     def __init__(self, params: ExistenceParams, stamp: float, standing: bool, arrived: bool,
                  leg_probability: float | None, leg_base_rate: float) -> None:
         self.params = params
+        # the bounds the evidence is kept in, and the shape term's, worked out once per track
+        self.l_delete = logit(params.delete)
+        self._l_dyn_bounds = (self.l_delete - 1.0, logit(params.max_evidence_probability))
+        self._l_shape_bounds = (math.log(params.min_shape_lr), math.log(params.max_shape_lr))
         self.base = logit(leg_base_rate)
         self.base_rate = leg_base_rate
         self.vouched = True  # static updates count as presence (False after a stale spell, until leg-like or moving)
@@ -160,10 +164,10 @@ class Existence:
 
     @shape_p.setter
     def shape_p(self, value: float) -> None:
-        p = self.params
         self._shape_p = value
         # the shape term, worked out once per change (it is read several times a scan)
-        self._l_shape = min(max(logit(value) - self.base, math.log(p.min_shape_lr)), math.log(p.max_shape_lr))
+        lo, hi = self._l_shape_bounds
+        self._l_shape = min(max(logit(value) - self.base, lo), hi)
 
     @property
     def l_shape(self) -> float:
@@ -227,7 +231,8 @@ class Existence:
                 if p.unseen_half_life_s > 0 and dt > 0:  # survival: P(still here) = P · 2^(-dt / half-life)
                     survived = self.probability * 0.5 ** (dt / p.unseen_half_life_s)
                     self.l_dyn = logit(survived) - self.l_shape
-        self.l_dyn = min(max(self.l_dyn, logit(p.delete) - 1.0), logit(p.max_evidence_probability))
+        lo, hi = self._l_dyn_bounds
+        self.l_dyn = min(max(self.l_dyn, lo), hi)
         if leg_probability is not None:
             a = 1.0 - math.exp(-dt / p.shape_time_s) if p.shape_time_s > 0 else 1.0
             self.shape_p += a * (leg_probability - self.shape_p)

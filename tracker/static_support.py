@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from people_tracker.detection.segments import run_bounds
+from people_tracker.detection.segments import run_bounds, segment_of_readings
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D, pairwise_distances
@@ -72,8 +72,9 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         found, centres = _support_kernel(
             pred_sensor, pts, seg_of, n_segments, free, needed_valid is not None,
             needed_valid if needed_valid is not None else free, radius_m, max_size_m, min_points, max_leg_radius_m)
-        for t in np.flatnonzero(found):
-            out[t] = pose.transform_points(centres[t:t + 1])[0]
+        if found.any():
+            for t in np.flatnonzero(found).tolist():
+                out[t] = pose.transform_points(centres[t:t + 1])[0]
         return out
     d = pairwise_distances(pred_sensor, pts)
     d[:, ~free] = np.inf
@@ -104,7 +105,7 @@ def scan_segments(scan: Scan, k_segment: float, segment_floor_m: float) -> tuple
     valid = scan.valid_index
     gap = range_threshold(scan.ranges[valid], scan.resolution, k_segment, segment_floor_m)
     bounds = run_bounds(scan.valid_points, gap)
-    return np.repeat(np.arange(len(bounds) - 1), np.diff(bounds)), len(bounds) - 1
+    return segment_of_readings(bounds), len(bounds) - 1
 
 
 def _support_loop(pred_sensor, pts, seg_of, n_segments, free, use_needed, needed, radius_m, max_size_m, min_points,

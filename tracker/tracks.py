@@ -11,7 +11,7 @@ from filterpy.kalman import KalmanFilter
 
 from people_tracker.detection.free_space import UNSEEN
 from people_tracker.models.motion import H, constant_velocity_step, cv_predict, position_update
-from people_tracker.tracker.existence import Existence, logit
+from people_tracker.tracker.existence import Existence
 
 
 @dataclass(frozen=True)
@@ -239,7 +239,7 @@ class TrackState:
         p, e = self.params, self.existence
         # the evidence of absence alone ends any track, whatever its shape; the shape too
         # ends a confirmed one (a tentative track's shape is not known well yet)
-        if e.l_dyn <= logit(e.params.delete):
+        if e.l_dyn <= e.l_delete:
             return "absence"
         if self.confirmed and e.probability < e.params.delete:
             return "existence"
