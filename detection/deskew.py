@@ -9,6 +9,8 @@ onto a beam grid of its own, so every later stage still gets an ordinary :class:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from people_tracker.models import compiled
@@ -68,15 +70,15 @@ def deskew_with_source(scan: Scan, pose_first: Pose2D, pose_last: Pose2D) -> tup
         return scan, np.where(scan.valid, np.arange(n), -1)
     # the sweep's rotation, spread over its beams, goes into the grid (unless it would fold it)
     increment = scan.angle_increment + motion.yaw / (n - 1)
-    if increment * scan.angle_increment <= 0 or abs(increment) < 0.5 * abs(scan.angle_increment):
+    if not math.isfinite(increment) or increment * scan.angle_increment <= 0 or \
+            abs(increment) < 0.5 * abs(scan.angle_increment):
         increment = scan.angle_increment
     if compiled.on:  # the rest as one compiled loop, the same arithmetic
         raw_bearings = scan.bearings if scan.bearings is not None else np.zeros(0)
         out, source, bearings, valid, no_return, points = _deskew_kernel(
             scan.ranges, raw_bearings, scan.bearings is not None, motion.x, motion.y, motion.yaw, scan.angle_min,
             scan.angle_increment, increment, scan.range_min, scan.range_max, compiled.trig_is_numpys)
-        new = Scan(out, scan.angle_min, increment, scan.range_min, scan.range_max, scan.stamp,
-                   scan.frame_id, scan.time_increment, bearings)
+        new = Scan._made_here(out, scan, increment, bearings)  # the kernel's fresh arrays, handed over
         # what the new scan's properties would compute, computed in the loop (the points
         # only where the C library's cos and sin are numpy's): the written beams are its valid
         # ones, the beams left inf its lines of sight with no return

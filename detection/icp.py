@@ -143,9 +143,10 @@ class ReferenceScan:
 
     def _set_usable(self, usable: np.ndarray) -> None:
         self.usable = usable
-        self.n_usable = int(usable.sum())
+        self.n_usable = int(np.count_nonzero(usable))
         # per KD-tree answer (an index, or one past the last for none): a partner with a normal
-        self.usable_or_none = np.append(usable, False)
+        self.usable_or_none = np.zeros(len(usable) + 1, dtype=bool)
+        self.usable_or_none[:-1] = usable
 
     def exclude(self, mask: np.ndarray) -> None:
         """Leave the readings ``mask`` marks (shape (n,)) out of matching."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -109,10 +110,10 @@ class Scan:
         ranges = np.array(self.ranges, dtype=np.float64)  # always a private copy
         if ranges.ndim != 1:
             raise ValueError(f"ranges must be one-dimensional, got shape {ranges.shape}")
-        if not np.isfinite(self.angle_increment) or self.angle_increment == 0.0:
+        if not math.isfinite(self.angle_increment) or self.angle_increment == 0.0:
             raise ValueError(f"angle_increment must be finite and non-zero, got {self.angle_increment}")
         for name in ("angle_min", "range_min", "range_max", "stamp", "time_increment"):
-            if not np.isfinite(getattr(self, name)):
+            if not math.isfinite(getattr(self, name)):
                 raise ValueError(f"{name} must be finite, got {getattr(self, name)}")
         ranges.setflags(write=False)
         object.__setattr__(self, "ranges", ranges)
@@ -123,6 +124,22 @@ class Scan:
             bearings.setflags(write=False)
             object.__setattr__(self, "bearings", bearings)
         object.__setattr__(self, "frame_id", str(self.frame_id).lstrip("/"))
+
+    @classmethod
+    def _made_here(cls, ranges: np.ndarray, like: "Scan", angle_increment: float,
+                   bearings: np.ndarray | None) -> "Scan":
+        """A scan with ``like``'s other fields, from arrays the caller has just made and
+        hands over (float64, one-dimensional, ``bearings`` of their shape or None; a
+        finite non-zero increment): what the constructor would make of them, without its
+        checks and copies (the de-skew's new scan, every scan)."""
+        new = object.__new__(cls)
+        ranges.setflags(write=False)
+        if bearings is not None:
+            bearings.setflags(write=False)
+        new.__dict__.update(ranges=ranges, angle_min=like.angle_min, angle_increment=angle_increment,
+                            range_min=like.range_min, range_max=like.range_max, stamp=like.stamp,
+                            frame_id=like.frame_id, time_increment=like.time_increment, bearings=bearings)
+        return new
 
     @property
     def n_beams(self) -> int:

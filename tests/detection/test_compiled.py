@@ -92,6 +92,10 @@ def test_deskew_agrees_on_simulated_lasers(laser):
         assert src.tobytes() == ref_src.tobytes()
         assert fast.ranges.tobytes() == ref.ranges.tobytes() and fast.bearings.tobytes() == ref.bearings.tobytes()
         assert fast.angle_increment == ref.angle_increment
+        # the scan the loop's arrays were handed to is what the constructor makes
+        for name in ("angle_min", "range_min", "range_max", "stamp", "frame_id", "time_increment"):
+            assert getattr(fast, name) == getattr(ref, name), name
+        assert not fast.ranges.flags.writeable and not fast.bearings.flags.writeable
         # the properties the loop filled in are what the scan would compute
         seeded = {"valid", "valid_index", "no_return"} | ({"points", "valid_points"} if compiled.trig_is_numpys else set())
         assert seeded <= set(vars(fast))
