@@ -433,8 +433,8 @@ class MovingObjectDetector:
             self._posed = np.array([p.pose is not None for p in self._history], dtype=bool)
             return
         last = self._history[-1]
-        self._stamps = np.append(self._stamps[dropped:], last.scan.stamp)
-        self._posed = np.append(self._posed[dropped:], last.pose is not None)
+        self._stamps = np.concatenate((self._stamps[dropped:], (last.scan.stamp,)))
+        self._posed = np.concatenate((self._posed[dropped:], (last.pose is not None,)))
 
     def _lookback(self, stamp: float, lookbacks_s: tuple[float, ...], need_pose: bool) -> list[_Past]:
         """For each lookback, the kept scan nearest ``stamp - lookback`` and at least half

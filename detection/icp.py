@@ -153,7 +153,7 @@ class ReferenceScan:
         self._set_usable(self.usable & ~mask)
 
 
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=1024)  # one per reading count a laser gives (an array of m indices each)
 def _spread(n: int, m: int) -> np.ndarray:
     """``m`` indices evenly spread over ``n`` readings (read-only, shared)."""
     index = np.linspace(0, n - 1, m).round().astype(np.int64)

@@ -87,6 +87,8 @@ class LegCandidates:
 
     def touching(self, mask: np.ndarray) -> np.ndarray:
         """Which candidates span a beam where ``mask`` (bool, one per beam of the scan) is set."""
+        if compiled.on and len(mask):  # the lines below as one compiled loop
+            return _touching_kernel(np.ascontiguousarray(mask, dtype=np.bool_), self.first_beam, self.last_beam)
         # c[i] counts the set beams before beam i
         c = np.concatenate([[0], np.cumsum(mask)])
         return c[self.last_beam + 1] > c[self.first_beam]
@@ -376,5 +378,18 @@ def _context_loop(shape, mean, end_beam, end_xy, end_r, valid, ranges, points, a
     return out
 
 
+def _touching_loop(mask, first_beam, last_beam):
+    """:meth:`LegCandidates.touching` as one loop (compiled by numba): whether any beam from
+    each candidate's first to its last is set."""
+    out = np.zeros(len(first_beam), np.bool_)
+    for k in range(len(first_beam)):
+        for b in range(first_beam[k], last_beam[k] + 1):
+            if mask[b]:
+                out[k] = True
+                break
+    return out
+
+
+_touching_kernel = njit(_touching_loop)
 _shape_kernel = njit(_shape_loop)
 _context_kernel = njit(_context_loop)

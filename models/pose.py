@@ -151,8 +151,26 @@ def interpolate_pose(p0: Pose2D, p1: Pose2D, fraction: float) -> Pose2D:
 
 def pairwise_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Euclidean distance of every point of ``a`` (shape (n, 2)) to every point of ``b``
-    (shape (m, 2)), both in one frame, metres; shape (n, m)."""
+    (shape (m, 2)), both in one frame, metres; shape (n, m). A compiled loop when numba is
+    on (the same subtractions and ``hypot``; numpy's broadcasting costs more than the
+    arithmetic for the few points a step compares)."""
+    if compiled.on:
+        a2, b2 = np.ascontiguousarray(a, dtype=np.float64), np.ascontiguousarray(b, dtype=np.float64)
+        if a2.ndim == 2 and b2.ndim == 2 and a2.shape[1] == 2 and b2.shape[1] == 2:
+            return _pairwise_kernel(a2, b2)
     return np.hypot(a[:, None, 0] - b[None, :, 0], a[:, None, 1] - b[None, :, 1])
+
+
+def _pairwise_loop(a, b):
+    """:func:`pairwise_distances` as one loop (compiled by numba)."""
+    out = np.empty((len(a), len(b)))
+    for i in range(len(a)):
+        for j in range(len(b)):
+            out[i, j] = np.hypot(a[i, 0] - b[j, 0], a[i, 1] - b[j, 1])
+    return out
+
+
+_pairwise_kernel = compiled.njit(_pairwise_loop)
 
 
 def near_any(a: np.ndarray, b: np.ndarray, radius_m: float) -> np.ndarray:

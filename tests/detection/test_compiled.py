@@ -524,3 +524,81 @@ def test_combining_the_comparisons_agrees():
         with compiled.numpy_only():
             ref = combine(pairs)
         assert fast.dtype == ref.dtype and fast.tobytes() == ref.tobytes(), k
+
+
+def test_the_nearest_earlier_scans_agree():
+    """The scans each comparison's Δt picks (the first of equally near ones), as np.argmin."""
+    from collections import deque
+
+    from people_tracker.detection.detector import DetectorParams, MovingObjectDetector
+    rng = np.random.default_rng(20)
+    for k in range(2000):
+        n = int(rng.integers(1, 40))
+        det = MovingObjectDetector(DetectorParams(compare_dt_s=tuple(rng.uniform(0.02, 1.0, int(rng.integers(1, 4))))))
+        det._history = deque(object() for _ in range(n))
+        det._stamps = np.sort(rng.uniform(0, 2, n)).round(1 if k % 2 else 6)  # rounded: ties
+        stamp = float(det._stamps[-1] + rng.uniform(0, 0.2))
+        fast = det._earlier(stamp)
+        with compiled.numpy_only():
+            ref = det._earlier(stamp)
+        assert [id(o) for o in fast] == [id(o) for o in ref], k
+
+
+def test_the_static_memorys_span_helpers_agree():
+    """The readings of a run of objects, each object's share of flagged readings, and the
+    occluded runs isolated_occluded keeps: compiled and in numpy."""
+    from people_tracker.detection.detector import _isolated_kernel, _share_per_span, _span_readings
+    from people_tracker.detection.labels import OCCLUDED
+    from people_tracker.detection.recover import isolated_occluded
+    from people_tracker.detection.segments import Segment, run_bounds
+    rng = np.random.default_rng(21)
+    kept = 0
+    for k in range(2000):
+        sizes = rng.integers(1, 30, int(rng.integers(1, 8)))
+        starts = np.cumsum(np.r_[0, sizes[:-1]]) + rng.integers(0, 3, len(sizes)).cumsum()
+        flags = rng.random(int(sizes.sum())) < rng.uniform(0, 1)
+        fast = (_span_readings(starts, sizes), _share_per_span(flags, sizes))
+        with compiled.numpy_only():
+            idx, share = _span_readings(starts, sizes), _share_per_span(flags, sizes)
+        assert fast[0].tobytes() == idx.tobytes() and fast[1].tobytes() == share.tobytes(), k
+        n = int(rng.integers(2, 120))
+        pts = np.cumsum(rng.normal(0, 0.05, (n, 2)), axis=0) + [2.0, 0.0]
+        ranges = np.hypot(pts[:, 0], pts[:, 1]) + np.where(rng.random(n) < 0.3, rng.uniform(0, 1, n), 0.0)
+        gap = rng.uniform(0.02, 0.12, n)
+        labels = rng.choice([1, 2, 3, 4], n, p=[0.3, 0.2, 0.4, 0.1]).astype(np.int8)
+        bounds = run_bounds(pts, gap, labels)
+        min_points, extent = int(rng.integers(1, 5)), float(rng.uniform(0.1, 1.0))
+        a, b = _isolated_kernel(bounds, labels, pts, ranges, gap, min_points, extent)
+        big = [Segment(int(s), int(e), OCCLUDED, (OCCLUDED,)) for s, e in zip(bounds[:-1], bounds[1:])
+               if labels[s] == OCCLUDED and e - s >= min_points]
+        ref = isolated_occluded(big, pts, ranges, gap, min_points, extent)
+        assert list(zip(a.tolist(), b.tolist())) == [(r.start, r.stop) for r in ref], k
+        kept += len(ref)
+    assert kept > 300
+
+
+def test_distances_leg_centres_and_touching_agree():
+    from people_tracker.detection.leg_features import LegCandidates
+    from people_tracker.models.pose import pairwise_distances
+    from people_tracker.tracker.pairing import leg_centres
+    rng = np.random.default_rng(22)
+    touched = 0
+    for k in range(1000):
+        a, b = rng.normal(0, 5, (int(rng.integers(0, 20)), 2)), rng.normal(0, 5, (int(rng.integers(0, 20)), 2))
+        widths = np.abs(rng.normal(0, 0.2, len(a)))
+        if k % 5 == 0 and len(a):
+            a[0, 1], widths[-1] = np.nan, np.nan
+        if k % 7 == 0 and len(a):
+            a[-1] = 0.0  # at the sensor: the direction's floor
+        n_beams = int(rng.integers(1, 100))
+        first = np.sort(rng.integers(0, n_beams, 6))
+        last = np.minimum(first + rng.integers(0, 5, 6), n_beams - 1)
+        legs = LegCandidates(first, last, first, last + 1, np.zeros((6, 2)), np.zeros((6, 1)))
+        mask = rng.random(n_beams) < 0.05
+        fast = (pairwise_distances(a, b), leg_centres(a, widths, 0.08), legs.touching(mask))
+        with compiled.numpy_only():
+            ref = (pairwise_distances(a, b), leg_centres(a, widths, 0.08), legs.touching(mask))
+        for f, r in zip(fast, ref):
+            assert f.shape == r.shape and f.tobytes() == r.tobytes(), k
+        touched += int(ref[2].sum())
+    assert touched > 200
