@@ -235,14 +235,19 @@ class Bag1Reader:
         hi = len(time) if stop is None else int(np.searchsorted(time[order], stop, side="left"))
         order = order[lo:hi]
         time, where, offset, base, which = time[order], where[order], offset[order], base[order], which[order]
-        if self._u8 is not None and len(time):  # uncompressed: every header read at once
-            at, size, ok = _message_spans(self._u8, base + offset)
+        if self._u8 is not None and len(time):  # uncompressed: the headers read many at once
             data = self._map
-            for t, cpos, off, k, a, n, good in zip(time.tolist(), where.tolist(), offset.tolist(), which.tolist(),
-                                                   at.tolist(), size.tolist(), ok.tolist()):
-                if not good:  # another layout: read field by field
-                    a, n = self._walk(data, cpos, off, self._chunks[cpos][0] + off)
-                yield conns[k], t, data[a:a + n]
+            lo, batch = 0, _FIRST_BATCH
+            while lo < len(time):  # in growing batches: a reader that stops early reads few
+                hi = min(lo + batch, len(time))
+                at, size, ok = _message_spans(self._u8, base[lo:hi] + offset[lo:hi])
+                for t, cpos, off, k, a, n, good in zip(time[lo:hi].tolist(), where[lo:hi].tolist(),
+                                                       offset[lo:hi].tolist(), which[lo:hi].tolist(), at.tolist(),
+                                                       size.tolist(), ok.tolist()):
+                    if not good:  # another layout: read field by field
+                        a, n = self._walk(data, cpos, off, self._chunks[cpos][0] + off)
+                    yield conns[k], t, data[a:a + n]
+                lo, batch = hi, min(4 * batch, _LAST_BATCH)
             return
         for t, cpos, off, k in zip(time.tolist(), where.tolist(), offset.tolist(), which.tolist()):
             data, chunk_base = self._chunk_data(cpos)
@@ -291,6 +296,11 @@ class Bag1Reader:
         self._u8 = None  # the file's bytes as an array hold the map open
         self._map.close()
         self._file.close()
+
+
+# the message headers an uncompressed bag's messages() reads at once: few first (the caller
+# may want one message, as the topic and frame discovery do), then more and more
+_FIRST_BATCH, _LAST_BATCH = 16, 16384
 
 
 def _u32_at(u8: np.ndarray, at: np.ndarray) -> np.ndarray:
