@@ -141,12 +141,8 @@ def interpolate_pose(p0: Pose2D, p1: Pose2D, fraction: float) -> Pose2D:
 
     Translation is linear and heading follows the shorter arc.
     """
-    dyaw = float(wrap_angle(p1.yaw - p0.yaw))
-    return Pose2D(
-        p0.x + fraction * (p1.x - p0.x),
-        p0.y + fraction * (p1.y - p0.y),
-        float(wrap_angle(p0.yaw + fraction * dyaw)),
-    )
+    dyaw = _wrap(p1.yaw - p0.yaw)
+    return _pose(p0.x + fraction * (p1.x - p0.x), p0.y + fraction * (p1.y - p0.y), _wrap(p0.yaw + fraction * dyaw))
 
 
 def pairwise_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
