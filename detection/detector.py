@@ -18,9 +18,9 @@ from people_tracker.detection.closest import closest_point_static
 from people_tracker.detection.kdtree import PointTree, grid_within_kernel
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
 from people_tracker.detection.objects import MovingObject, describe_all
-from people_tracker.detection.recover import isolated_occluded, recover_from_bounds
+from people_tracker.detection.recover import isolated_from_bounds, recover_from_bounds
 from people_tracker.detection.scan_lines import bin_to_beams, line_labels_kernel, scan_line_labels
-from people_tracker.detection.segments import Segment, means_and_chords, run_bounds
+from people_tracker.detection.segments import means_and_chords, run_bounds
 from people_tracker.detection.thresholds import range_threshold
 from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D, pairwise_distances, transform_kernel
@@ -338,28 +338,6 @@ def _share_per_span(flags: np.ndarray, sizes: np.ndarray) -> np.ndarray:
     return np.add.reduceat(flags.astype(float), np.concatenate([[0], np.cumsum(sizes)[:-1]])) / sizes
 
 
-def _isolated_loop(bounds, run_labels, points, ranges, gap, min_points, max_extent):
-    """The O runs of at least ``min_points`` readings (``bounds``: the runs' first readings
-    and one past the last; ``run_labels``: each valid reading's label) that
-    :func:`~people_tracker.detection.recover.isolated_occluded` keeps, as one loop (compiled by
-    numba; its tests in its order): their first readings and one past their last."""
-    n = len(points)
-    starts, stops = np.empty(len(bounds), np.int64), np.empty(len(bounds), np.int64)
-    k = 0
-    for r in range(len(bounds) - 1):
-        a, b = bounds[r], bounds[r + 1]
-        if run_labels[a] != OCCLUDED or b - a < min_points:
-            continue
-        if np.hypot(points[b - 1, 0] - points[a, 0], points[b - 1, 1] - points[a, 1]) > max_extent:
-            continue
-        left_ok = a == 0 or ranges[a - 1] > ranges[a] + gap[a]
-        right_ok = b == n or ranges[b] > ranges[b - 1] + gap[b - 1]
-        if left_ok and right_ok:
-            starts[k], stops[k] = a, b
-            k += 1
-    return starts[:k], stops[:k]
-
-
 def _share_loop(flags, sizes):
     """:func:`_share_per_span` as one loop (compiled by numba): the count over the size, as
     numpy's sum of ones and zeros (exact) over it."""
@@ -604,18 +582,9 @@ class MovingObjectDetector:
                                     p.max_object_size_m, p.single_object_max_o)
         if p.isolated_o_objects:  # objects moving away, whatever else moves (extends Algorithm 3)
             taken = {(r.start, r.stop) for r in found}
-            if compiled.on and len(pts):  # the runs and isolated_occluded below as one compiled loop
-                starts, stops = _isolated_kernel(bounds, run_labels, pts, scan.ranges[valid], gap, p.min_object_points,
-                                                 p.max_object_size_m)
-                isolated = [Segment(a, b, OCCLUDED, (OCCLUDED,)) for a, b in zip(starts.tolist(), stops.tolist())]
-            else:
-                first = bounds[:-1]
-                big_o = np.flatnonzero((run_labels[first] == OCCLUDED) & (np.diff(bounds) >= p.min_object_points))
-                runs = [Segment(a, b, OCCLUDED, (OCCLUDED,))
-                        for a, b in zip(first[big_o].tolist(), bounds[big_o + 1].tolist())]
-                isolated = isolated_occluded(runs, pts, scan.ranges[valid], gap, p.min_object_points,
-                                             p.max_object_size_m)
-            found += [r for r in isolated if (r.start, r.stop) not in taken]
+            found += [r for r in isolated_from_bounds(bounds, run_labels, pts, scan.ranges[valid], gap,
+                                                      p.min_object_points, p.max_object_size_m)
+                      if (r.start, r.stop) not in taken]
         found = [seg for seg in found if seg.size >= p.min_object_points]
         # static things that flicker are not moving (extension, see DetectorParams)
         keep = self._static_memory(scan, pose, [(seg.start, seg.stop) for seg in found], pts,
@@ -642,7 +611,6 @@ _combine_kernel = compiled.njit(_combine_loop)
 _lookback_kernel = compiled.njit(_lookback_loop)
 _nearest_kernel = compiled.njit(_nearest_loop)
 _share_kernel = compiled.njit(_share_loop)
-_isolated_kernel = compiled.njit(_isolated_loop)
 _span_readings_kernel = compiled.njit(_span_readings_loop)
 _carried_kernel = compiled.njit(_carried_loop)
 _seen_kernel = compiled.njit(_seen_loop)

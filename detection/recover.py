@@ -128,6 +128,41 @@ def recover_from_bounds(bounds: np.ndarray, labels: np.ndarray, points: np.ndarr
             zip(starts.tolist(), stops.tolist(), labs.tolist(), sets.tolist())]
 
 
+def isolated_from_bounds(bounds: np.ndarray, labels: np.ndarray, points: np.ndarray, ranges: np.ndarray,
+                         gap: np.ndarray, min_points: int, max_extent: float) -> list[Segment]:
+    """:func:`isolated_occluded` of the runs ``bounds`` gives (as :func:`recover_from_bounds`
+    takes them; ``ranges`` and ``gap`` per valid reading): the same segments, from one
+    compiled call when the kernels are on."""
+    if len(bounds) < 2:
+        return []
+    if not compiled.on:
+        return isolated_occluded(runs_of(bounds, labels), points, ranges, gap, min_points, max_extent)
+    starts, stops = _isolated_kernel(bounds, labels, points, ranges, gap, min_points, max_extent)
+    return [Segment(a, b, OCCLUDED, (OCCLUDED,)) for a, b in zip(starts.tolist(), stops.tolist())]
+
+
+def _isolated_loop(bounds, run_labels, points, ranges, gap, min_points, max_extent):
+    """The O runs of at least ``min_points`` readings (``bounds``: the runs' first readings
+    and one past the last; ``run_labels``: each valid reading's label) that
+    :func:`isolated_occluded` keeps, as one loop (compiled by numba; its tests in its
+    order): their first readings and one past their last."""
+    n = len(points)
+    starts, stops = np.empty(len(bounds), np.int64), np.empty(len(bounds), np.int64)
+    k = 0
+    for r in range(len(bounds) - 1):
+        a, b = bounds[r], bounds[r + 1]
+        if run_labels[a] != OCCLUDED or b - a < min_points:
+            continue
+        if np.hypot(points[b - 1, 0] - points[a, 0], points[b - 1, 1] - points[a, 1]) > max_extent:
+            continue
+        left_ok = a == 0 or ranges[a - 1] > ranges[a] + gap[a]
+        right_ok = b == n or ranges[b] > ranges[b - 1] + gap[b - 1]
+        if left_ok and right_ok:
+            starts[k], stops[k] = a, b
+            k += 1
+    return starts[:k], stops[:k]
+
+
 # a segment's sets as a bit mask (bit label + 1, so the noise label -1 is bit 0), and back
 _LABELS = (-1, 0, 1, 2, 3, 4)
 _SETS = {mask: tuple(lab for lab in _LABELS if mask >> (lab + 1) & 1) for mask in range(1 << len(_LABELS))}
@@ -215,3 +250,4 @@ def _recover_loop(bounds, run_labels, points, join_threshold, min_seed, min_poin
 
 _join_runs = compiled.njit(_join_runs, helper=True) or _join_runs
 _recover_kernel = compiled.njit(_recover_loop)
+_isolated_kernel = compiled.njit(_isolated_loop)

@@ -547,9 +547,9 @@ def test_the_nearest_earlier_scans_agree():
 def test_the_static_memorys_span_helpers_agree():
     """The readings of a run of objects, each object's share of flagged readings, and the
     occluded runs isolated_occluded keeps: compiled and in numpy."""
-    from people_tracker.detection.detector import _isolated_kernel, _share_per_span, _span_readings
+    from people_tracker.detection.detector import _share_per_span, _span_readings
     from people_tracker.detection.labels import OCCLUDED
-    from people_tracker.detection.recover import isolated_occluded
+    from people_tracker.detection.recover import isolated_from_bounds, isolated_occluded
     from people_tracker.detection.segments import Segment, run_bounds
     rng = np.random.default_rng(21)
     kept = 0
@@ -568,11 +568,13 @@ def test_the_static_memorys_span_helpers_agree():
         labels = rng.choice([1, 2, 3, 4], n, p=[0.3, 0.2, 0.4, 0.1]).astype(np.int8)
         bounds = run_bounds(pts, gap, labels)
         min_points, extent = int(rng.integers(1, 5)), float(rng.uniform(0.1, 1.0))
-        a, b = _isolated_kernel(bounds, labels, pts, ranges, gap, min_points, extent)
+        fast = isolated_from_bounds(bounds, labels, pts, ranges, gap, min_points, extent)
+        with compiled.numpy_only():
+            assert isolated_from_bounds(bounds, labels, pts, ranges, gap, min_points, extent) == fast, k
         big = [Segment(int(s), int(e), OCCLUDED, (OCCLUDED,)) for s, e in zip(bounds[:-1], bounds[1:])
                if labels[s] == OCCLUDED and e - s >= min_points]
         ref = isolated_occluded(big, pts, ranges, gap, min_points, extent)
-        assert list(zip(a.tolist(), b.tolist())) == [(r.start, r.stop) for r in ref], k
+        assert fast == ref, k
         kept += len(ref)
     assert kept > 300
 
