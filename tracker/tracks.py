@@ -46,6 +46,14 @@ class TrackParams:
         Two people's torsos are never closer than this, metres: a track that comes this
         close to one standing still is that person twice, and the newcomer is deleted; and
         a person standing still takes a moving candidate only this close (setting off).
+    unobserved_sensor_speed_mps, unobserved_sensor_turn_radps : float
+        How far off the sensor's own motion may be, as speed (m/s) and turn rate (rad/s),
+        while nothing measures it: no odometry, and scan matching failed (nothing in range
+        to match). The world frame then moves with a predicted motion, and everything seen
+        in it, the tracks' people included, may be off by as much: each such scan widens
+        every track's position uncertainty by what the unmeasured motion can move it since
+        its last update (see :meth:`TrackState.widen_for_sensor_motion`). 0 trusts the
+        prediction.
     """
 
     accel_std_mps2: float = 1.5
@@ -57,6 +65,8 @@ class TrackParams:
     still_after_s: float = 1.0
     still_drift_mps: float = 0.1
     min_person_separation_m: float = 0.35
+    unobserved_sensor_speed_mps: float = 0.5
+    unobserved_sensor_turn_radps: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -147,6 +157,27 @@ class TrackState:
                 self.kf.x, self.kf.P = cv_predict(self.kf.x, self.kf.P, step, Q)
             self.stamp = stamp
         self.update_kind = None
+
+    def widen_for_sensor_motion(self, sensor_xy: np.ndarray, dt: float) -> None:
+        """Widen the position uncertainty for a sensor motion nobody measured over the last
+        ``dt`` seconds (the sensor at ``sensor_xy`` in the world frame, m): its speed may be
+        off by ``unobserved_sensor_speed_mps`` and its turn rate by
+        ``unobserved_sensor_turn_radps``, which moves a place ``r`` metres away across the
+        beam by ``r`` times the turn. Since the track's last update the error grows with the
+        time ``T`` (an unmeasured motion persists from scan to scan): this scan adds
+        ``σ²·(T² − (T − dt)²)``, so that after ``T`` seconds the total is ``σ²·T²`` at any
+        scan rate."""
+        p = self.params
+        if dt <= 0 or (p.unobserved_sensor_speed_mps <= 0 and p.unobserved_sensor_turn_radps <= 0):
+            return
+        since = max(self.stamp - self.last_update, dt)
+        grow = since * since - (since - dt) ** 2
+        d = self.position - np.asarray(sensor_xy, dtype=float)
+        r = float(np.hypot(d[0], d[1]))
+        across = np.array([-d[1], d[0]]) / r if r > 1e-9 else np.zeros(2)
+        cov = grow * (p.unobserved_sensor_speed_mps ** 2 * np.eye(2)
+                      + (r * p.unobserved_sensor_turn_radps) ** 2 * np.outer(across, across))
+        self.kf.P[0::2, 0::2] += cov
 
     def forget_velocity(self) -> None:
         """Reset the velocity's uncertainty to a new track's (after a sharp turn)."""

@@ -123,6 +123,27 @@ def new_track(x=0.0, y=0.0, params=None, standing=False, arrived=True, existence
     return TrackState(1, x, y, R, 0.0, params or TrackParams(), ex, standing), R
 
 
+def test_an_unmeasured_sensor_motion_widens_tracks_as_much_at_any_scan_rate():
+    """Without odometry, while scan matching fails, each scan widens a track's position
+    uncertainty: after T seconds without an update by (speed x T)² in every direction plus
+    (range x turn x T)² across the beam, whatever the scan rate; 0 trusts the prediction."""
+    params = TrackParams(unobserved_sensor_speed_mps=0.5, unobserved_sensor_turn_radps=0.2)
+    for dt in (0.1, 0.04):
+        t, _ = new_track(3.0, 4.0, params=params)  # 5 m from the sensor at the origin
+        p0 = t.kf.P[0::2, 0::2].copy()
+        for k in range(1, int(round(1.0 / dt)) + 1):  # one second, no update
+            t.stamp = k * dt
+            t.widen_for_sensor_motion(np.zeros(2), dt)
+        added = t.kf.P[0::2, 0::2] - p0
+        along, across = np.array([0.6, 0.8]), np.array([-0.8, 0.6])
+        assert along @ added @ along == pytest.approx(0.5 ** 2)
+        assert across @ added @ across == pytest.approx(0.5 ** 2 + (5.0 * 0.2) ** 2)
+    t, _ = new_track(3.0, 4.0, params=TrackParams(unobserved_sensor_speed_mps=0.0, unobserved_sensor_turn_radps=0.0))
+    p0 = t.kf.P.copy()
+    t.widen_for_sensor_motion(np.zeros(2), 0.1)
+    assert np.array_equal(t.kf.P, p0)
+
+
 def test_lifecycle_exactly():
     """norfair-style: the state after each scan for a scripted stream, from the evidence alone."""
     e = ExistenceParams()
