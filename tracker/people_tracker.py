@@ -173,7 +173,6 @@ class PeopleTracker:
         self._tracks: list[TrackState] = []
         self._next_id = 1
         self.last: StepResult | None = None
-        self._last_stamp: float | None = None  # the previous scan's stamp, s
         self.bad_poses = 0  # poses given with a scan that were not finite (the scan was used without)
 
     @classmethod
@@ -191,7 +190,6 @@ class PeopleTracker:
         self._arrivals.reset()
         self._judged = np.zeros((0, 4))
         self.places.reset()
-        self._last_stamp = None
         if self.selector is not None:
             self.selector.forget_path()  # the world frame may start anew: no velocity across the jump
 
@@ -218,13 +216,12 @@ class PeopleTracker:
         detection = self.detector.detect(scan, world, world.inverse().transform_points(people) if len(people) else None,
                                          aligned.tree)
         # the sensor's motion since the last scan was measured by neither odometry nor a match
+        # (a match needs a previous scan, so there was a last step)
         unmeasured = aligned.prior == "prediction" and aligned.match is not None and not aligned.match.ok
-        dt = scan.stamp - self._last_stamp if self._last_stamp is not None else 0.0
-        self._last_stamp = scan.stamp
         for t in self._tracks:  # 2. predict every track to the scan time
             t.predict(scan.stamp)
             if unmeasured:
-                t.widen_for_sensor_motion((world.x, world.y), dt)
+                t.widen_for_sensor_motion((world.x, world.y), scan.stamp - self.last.scan.stamp)
         legs = leg_candidates(scan)  # every leg candidate and its probability, by shape alone
         leg_scores = self.leg_model.probability(legs.features)
         self._legs_world = world.transform_points(legs.xy) if len(legs.xy) else np.zeros((0, 2))
