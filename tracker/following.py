@@ -76,7 +76,12 @@ class TargetSelector:
         The person's place relative to the sensor averaged over ``steady_s`` seconds: a
         target track that moved more than ``slide_m`` from it, while exactly one other track
         was updated within ``reacquire_m`` of it, slid onto someone passing between; the
-        id goes to that one.
+        person is lost (and the re-lock looks for them).
+    trail_s : float
+        ... unless that other track was farther than ``reacquire_m`` from the averaged place
+        ``trail_s`` seconds ago (or where it began, if later): it walked in from elsewhere, a
+        passer-by stepping where the person was a moment ago while the average lags a person
+        who moves relative to the sensor (:meth:`came_from_elsewhere`).
     """
 
     def __init__(self, mode: str | int | None, reacquire_s: float = 10.0, reacquire_m: float = 0.8,
@@ -84,13 +89,15 @@ class TargetSelector:
                  coast_s: float = 0.5, max_reach_m: float = 4.0, steady_s: float = 1.5,
                  slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35,
                  lane_m: float = 0.75, same_velocity_mps: float = 0.2, other_velocity_mps: float = 1.2,
-                 max_walk_change_mps: float | None = 1.0, sensor_velocity_s: float = 0.5) -> None:
+                 max_walk_change_mps: float | None = 1.0, sensor_velocity_s: float = 0.5,
+                 trail_s: float = 1.0) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
         self._ahead_rad, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
         self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
         self.relock_s, self._same_person_m, self._lane_m = relock_s, same_person_m, lane_m
+        self.trail_s = trail_s
         self._gave_up = False  # whether a person locked onto was ever lost for good
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
@@ -193,6 +200,11 @@ class TargetSelector:
         where, reach = (self.steady, self._reacquire_m) if steady else exp
         near = [tid for tid, q in others.items() if float(np.hypot(*(q - where))) <= reach]
         return near[0] if len(near) == 1 else None
+
+    def came_from_elsewhere(self, place_then: np.ndarray) -> bool:
+        """Whether a track that was at ``place_then`` (sensor frame then, m) ``trail_s`` ago
+        came from farther than ``reacquire_m`` from where the person has been lately."""
+        return self.steady is not None and float(np.hypot(*(np.asarray(place_then) - self.steady))) > self._reacquire_m
 
     def slid(self, q: np.ndarray) -> bool:
         """Whether the target track at ``q`` (sensor frame, m) is far from where the person has been lately."""

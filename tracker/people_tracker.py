@@ -12,6 +12,8 @@ from __future__ import annotations
 import logging
 import math
 import time
+import weakref
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -171,6 +173,8 @@ class PeopleTracker:
         self._explained: np.ndarray | None = None  # this scan's readings taken by moving candidates given to tracks
         self._segments: tuple = (None, None)  # (scan, its scan_segments) for static support's calls on it
         self._tracks: list[TrackState] = []
+        # each track's places in the sensor frame over the selector's trail_s: (stamp s, place m)
+        self._trails: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
         self._next_id = 1
         self.last: StepResult | None = None
         self.bad_poses = 0  # poses given with a scan that were not finite (the scan was used without)
@@ -993,15 +997,24 @@ class PeopleTracker:
         def here(tracks) -> dict[int, np.ndarray]:  # id -> place in the sensor frame (m)
             return {u.track_id: inv.transform_points(u.position[None])[0] for u in tracks}
 
+        for u, q in zip(self._tracks, inv.transform_points(np.array([u.position for u in self._tracks]).reshape(-1, 2))):
+            trail = self._trails.setdefault(u, deque())
+            trail.append((stamp, q))
+            while len(trail) > 1 and trail[1][0] <= stamp - sel.trail_s:
+                trail.popleft()  # trail[0]: where it was trail_s ago, or where it began
+
         if sel.target is not None:
             t = next((u for u in self._tracks if u.track_id == sel.target), None)
             q = here([t])[t.track_id] if t is not None else None
             if t is not None and t.reported and not sel.within_reach(stamp, q):
                 t = self._retire(t)  # it is somewhere the person cannot be: on someone or something else
             if t is not None and t.reported and t.updated_now and sel.slid(q):
-                # moved off where the person has been while another track is there: it slid onto a passer-by
-                if sel.only_one_near(stamp, here(u for u in self._tracks if u is not t and u.updated_now),
-                                     steady=True) is not None:
+                # moved off where the person has been while another track is there: it slid onto a passer-by,
+                # unless that one has just come there from elsewhere (a passer-by where the person was)
+                now = [u for u in self._tracks if u is not t and u.updated_now]
+                there = sel.only_one_near(stamp, here(now), steady=True)
+                if there is not None and not sel.came_from_elsewhere(
+                        self._trails[next(u for u in now if u.track_id == there)][0][1]):
                     t = self._retire(t)
                     sel.lost(stamp)
             if t is not None and t.reported and t.updated_now:
