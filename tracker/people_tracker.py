@@ -994,14 +994,14 @@ class PeopleTracker:
         sel.yaw = world.yaw
         sel.moved(stamp, world.x, world.y)
 
-        def here(tracks) -> dict[int, np.ndarray]:  # id -> place in the sensor frame (m)
-            return {u.track_id: inv.transform_points(u.position[None])[0] for u in tracks}
-
         for u, q in zip(self._tracks, inv.transform_points(np.array([u.position for u in self._tracks]).reshape(-1, 2))):
             trail = self._trails.setdefault(u, deque())
             trail.append((stamp, q))
             while len(trail) > 1 and trail[1][0] <= stamp - sel.trail_s:
                 trail.popleft()  # trail[0]: where it was trail_s ago, or where it began
+
+        def here(tracks) -> dict[int, np.ndarray]:  # id -> place in the sensor frame (m), as just put in its trail
+            return {u.track_id: self._trails[u][-1][1] for u in tracks}
 
         if sel.target is not None:
             t = next((u for u in self._tracks if u.track_id == sel.target), None)

@@ -581,7 +581,7 @@ def test_a_passer_by_stepping_where_the_person_just_stood_does_not_take_the_targ
     """Development runs indoors (narrow laser, seed 1): of 22 times the slide test found the
     target slid off where the person had been lately, 15 had it on the person, who had moved
     relative to the sensor faster than the 1.5 s average follows; 9 of those had a passer-by
-    walk into the averaged place from 0.8-2.7 m away within the last second. A track that
+    walk into the averaged place from 1.1-2.7 m away (one from 0.55 m) within the last second. A track that
     came there from elsewhere is not evidence that the target slid."""
     tracker, pid = _side_step(passer_from=(2.0, -2.2))
     assert tracker.selector.lost_since is None
