@@ -82,6 +82,15 @@ class TargetSelector:
         ``trail_s`` seconds ago (or where it began, if later): it walked in from elsewhere, a
         passer-by stepping where the person was a moment ago while the average lags a person
         who moves relative to the sensor (:meth:`came_from_elsewhere`).
+    settle_s, settle_margin_m : float
+        ``auto``: for ``settle_s`` seconds after the first lock, a reported person in the lane
+        more nearly straight ahead than the target by at least ``settle_margin_m`` metres takes
+        the target, unless their offset from the axis changed by more than that over the last
+        ``trail_s`` (or since they began): someone crossing the robot's way passes its axis.
+        The choice is still being made: whoever is reported first is not always the one in the
+        robot's way. A passer-by close in front is seen moving at once, while the person to
+        follow, walking away from the laser in their own shadow, may be confirmed a few tenths
+        of a second later. 0 s: the first lock holds.
     """
 
     def __init__(self, mode: str | int | None, reacquire_s: float = 10.0, reacquire_m: float = 0.8,
@@ -90,7 +99,7 @@ class TargetSelector:
                  slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35,
                  lane_m: float = 0.75, same_velocity_mps: float = 0.2, other_velocity_mps: float = 1.2,
                  max_walk_change_mps: float | None = 1.0, sensor_velocity_s: float = 0.5,
-                 trail_s: float = 1.0) -> None:
+                 trail_s: float = 1.0, settle_s: float = 2.0, settle_margin_m: float = 0.2) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
@@ -98,6 +107,8 @@ class TargetSelector:
         self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
         self.relock_s, self._same_person_m, self._lane_m = relock_s, same_person_m, lane_m
         self.trail_s = trail_s
+        self.settle_s, self.settle_margin_m = settle_s, settle_margin_m
+        self._locked_at: float | None = None  # when the first lock was made (s)
         self._gave_up = False  # whether a person locked onto was ever lost for good
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
@@ -288,9 +299,17 @@ class TargetSelector:
             return None
         return ahead[0]
 
-    def choose(self, reported: dict[int, np.ndarray]) -> int | None:
-        """The target id now, given reported tracks (id → sensor-frame place, m)."""
-        if self.target is not None or self.mode != "auto":
+    def choose(self, reported: dict[int, np.ndarray], stamp: float | None = None,
+               then: dict[int, np.ndarray] | None = None) -> int | None:
+        """The target id now, given reported tracks (id → sensor-frame place, m) at ``stamp``
+        (s; without it the first lock is never revised, see ``settle_s``) and, when known,
+        where they were ``trail_s`` ago or where they began (id → place in the sensor frame
+        then, m)."""
+        if self.mode != "auto":
+            return self.target
+        settling = (self.target is not None and not self._gave_up and stamp is not None
+                    and self._locked_at is not None and stamp - self._locked_at <= self.settle_s)
+        if self.target is not None and not settling:
             return self.target
         if self._gave_up:  # they went: whoever comes back closest ahead is most likely them
             best = self._ahead(reported)
@@ -298,7 +317,18 @@ class TargetSelector:
             aside = {tid: abs(float(reported[tid][1])) for tid in self.in_front(reported)}  # m off the axis
             lane = [tid for tid, off in aside.items() if off <= self._lane_m]
             best = min(lane, key=lambda tid: (aside[tid], tid)) if lane else None
+            if settling:  # someone clearly more in the robot's way than the target takes it
+                # ... and stays there (someone crossing the robot's way passes its axis)
+                if (best is None or best == self.target or self.target not in aside
+                        or aside[best] + self.settle_margin_m > aside[self.target]
+                        or (then and best in then
+                            and abs(float(reported[best][1] - then[best][1])) > self.settle_margin_m)):
+                    return self.target
+                self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None  # learnt afresh
+                self.velocity, self.lost_since = None, None
         if best is not None:
+            if self.target is None:
+                self._locked_at = stamp
             self.target = best
             self.events.append(f"target {best}")
         return self.target

@@ -1036,7 +1036,8 @@ class PeopleTracker:
                     new = next(u for u in self._tracks if u.track_id == new_id)
                     new.track_id = sel.target  # the person keeps their id
         reported = here(u for u in self._tracks if u.reported and u not in unreported)
-        target = sel.choose(reported)
+        target = sel.choose(reported, stamp, {u.track_id: self._trails[u][0][1] for u in self._tracks
+                                              if u.track_id in reported})
         t = next(u for u in self._tracks if u.track_id == target) if target in reported else None  # ids are unique
         if t is not None and sel.expected(stamp) is None:
             sel.seen(stamp, reported[target], t.velocity)
