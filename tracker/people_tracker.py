@@ -644,7 +644,13 @@ class PeopleTracker:
                                                               else radius_m)
 
     def _support(self, scan: Scan, world: Pose2D, matched: set[int]) -> None:
-        idle = [i for i, t in enumerate(self._tracks) if t.confirmed and i not in matched]
+        """Static support (a person-sized group of readings near the track) updates the
+        confirmed tracks no candidate reached this scan, and the tentative ones that began
+        standing where someone arrived (their place seen empty before): someone who stands
+        with their legs together, one segment the leg model scores low, earns their
+        confirmation by staying (``existence.present_lr``), as a confirmed person keeps it."""
+        idle = [i for i, t in enumerate(self._tracks) if i not in matched and (
+            t.confirmed or (t.born_standing and not t.moved and t.existence.walked_or_arrived))]
         if not idle:
             return
         found = self._static_support(np.array([self._tracks[i].position for i in idle]), scan, world)

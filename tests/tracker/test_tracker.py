@@ -9,6 +9,7 @@ from people_tracker.models.scan import Scan
 from people_tracker.tracker.config import config_from_dict, load_config
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.io.ground_truth import GroundTruth
+from people_tracker.tracker.io.simulated import SimulatedSource
 from people_tracker.tracker.pairing import PairingParams, PersonCandidate, pair_legs
 from people_tracker.tracker.people_tracker import AssociationParams, PeopleTracker, tracks_in_sensor_frame
 from people_tracker.detection.free_space import OCCLUDED, OCCUPIED, SEEN_THROUGH, UNSEEN
@@ -848,3 +849,28 @@ def test_a_walker_passing_close_keeps_their_leg_from_someone_standing():
     tracker = PeopleTracker.from_config(off)
     tracker._tracks = [stander, walker]
     assert tracker._associate([merged]) == [(0, 0)]
+
+
+def test_someone_who_arrived_and_stands_with_their_legs_together_is_confirmed_by_staying():
+    """Traced in the waiting room (seed 23, in-sample): person 10 walked in at 194 s, stood
+    hidden behind someone for 143 s, then in plain view for 25 s before walking out. Their
+    legs were one segment the leg model scored about 0.2: a standing track started where
+    they had arrived (the floor seen empty before), but with nothing to update it, it never
+    reached `existence.confirm`, and nine tracks came and went, unreported. Static support
+    now updates such a tentative track, and staying confirms it."""
+    src = SimulatedSource("waiting_room", seed=23)
+    tracker = PeopleTracker.from_config(load_config())
+    start, reported = None, []
+    for rec in src.scans():
+        start = rec.scan.stamp if start is None else start
+        t = rec.scan.stamp - start
+        if t > 345.0:
+            break
+        tracks = tracker.step(rec.scan, rec.pose, rec.pose_last_beam)
+        if t >= 343.7:  # 2 s after they came into view at 341.7 s
+            truth = src.truths[-1]
+            person = truth.torso_sensor[truth.person_id == 10][0]
+            assert truth.visible[truth.person_id == 10][0]
+            xy = tracks_in_sensor_frame(tracks, tracker.last.pose)
+            reported.append(bool(len(xy)) and float(np.hypot(*(xy - person).T).min()) <= 0.3)
+    assert reported and all(reported), reported
