@@ -170,6 +170,11 @@ class TargetSelector:
         refs = [r for r in (self.velocity, self.sensor_velocity()) if r is not None]
         return not refs or min(float(np.hypot(*(velocity - r))) for r in refs) <= self._max_walk_change
 
+    def _forget_place(self) -> None:
+        """Forget where the person is relative to the sensor (learnt afresh from the next
+        track seen as them)."""
+        self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
+
     def coasting(self, stamp: float, last_update: float) -> bool:
         """Whether a track last updated at ``last_update`` (s) has coasted ``coast_s`` by
         ``stamp`` (s): where the person is now is then a guess."""
@@ -232,7 +237,8 @@ class TargetSelector:
             self._gave_up = True
             self.lost_since = None
             if self.mode == "auto":
-                self.target, self._q, self._t, self._v, self.steady = None, None, None, np.zeros(2), None
+                self.target = None
+                self._forget_place()
             return None
         if self.mode != "auto":  # the id goes to the one track within reach of where they should be
             best = self.only_one_near(stamp, others)
@@ -244,7 +250,7 @@ class TargetSelector:
             if best is not None and velocities is not None and not self.walks_as_expected(velocities.get(best)):
                 best = None  # walking as neither the person nor the robot that follows them: a passer-by
             if best is not None:  # where they are now is learnt afresh
-                self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
+                self._forget_place()
         else:
             best = None
         if best is not None:
@@ -324,7 +330,7 @@ class TargetSelector:
                         or (then and best in then
                             and abs(float(reported[best][1] - then[best][1])) > self.settle_margin_m)):
                     return self.target
-                self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None  # learnt afresh
+                self._forget_place()  # learnt afresh
                 self.velocity, self.lost_since = None, None
         if best is not None:
             if self.target is None:
