@@ -57,7 +57,9 @@ class DetectorParams:
         A previous beam with no return (``inf``, REP 117) counts as a line of sight seen
         through up to this range (m; capped at range_max) in Algorithm 1, so a reading in
         front of it is moving rather than out of view; 0 turns it off. Dark surfaces also
-        give no return, hence a limit.
+        give no return, hence a limit, and only runs of such beams that open onto the open
+        count (:meth:`Scan.open_no_return`): a dark patch with a return on both sides, or a
+        dropout narrower than a leg, does not.
     static_memory_s, static_memory_k, static_memory_share
         An extension for static things that flicker (thin or dark objects that return a
         reading in one scan and none in the next, so they look newly arrived): an object is
@@ -183,11 +185,11 @@ def _free_points(prev: Scan, rel: Pose2D, params: DetectorParams) -> np.ndarray:
     """The lines of sight the earlier scan saw through (no return), free up to
     ``no_return_free_m``: their far ends in the current sensor frame (metres, shape (k, 2);
     ``rel`` is current_T_previous)."""
-    far = np.flatnonzero(prev.no_return) if params.no_return_free_m > 0 else ()
+    reach = min(prev.range_max, params.no_return_free_m)
+    far = np.flatnonzero(prev.open_no_return(reach)) if params.no_return_free_m > 0 else ()
     if not len(far):
         return np.zeros((0, 2))
     a = prev.angles[far]
-    reach = min(prev.range_max, params.no_return_free_m)
     return rel.transform_points(reach * np.column_stack([np.cos(a), np.sin(a)]))
 
 

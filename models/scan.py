@@ -58,6 +58,9 @@ def beam_index(bearing, angle_min: float, angle_increment: float, n_beams: int) 
     return np.where(inside, step, -1).astype(np.int64)
 
 
+OPEN_RUN_MIN_WIDTH_M = 0.1  # m: a run of no-return beams narrower than a leg at the reach is a dropout
+
+
 @dataclass(frozen=True, eq=False)
 class Scan:
     """One sweep of a planar laser scanner (ROS ``sensor_msgs/LaserScan`` semantics).
@@ -165,6 +168,35 @@ class Scan:
             mask = np.isposinf(r) | (np.isfinite(r) & (r >= self.range_max))
         mask.setflags(write=False)
         return mask
+
+    def open_no_return(self, reach_m: float) -> np.ndarray:
+        """Beams with no return (:attr:`no_return`) in a run of them that opens onto free space:
+        the nearest valid reading beside the run, on at least one side, lies beyond
+        ``reach_m`` (m), or there is none on that side. A run with a return nearer than that
+        on both sides is a dark or shiny patch of one surface, or lost readings, not a line
+        of sight into the open. With ``reach_m`` at or beyond range_max (the laser trusted to
+        return from everything in its range) every beam with no return counts; at 0 or
+        below, none is trusted and the mask is :attr:`no_return`. Boolean mask, shape (n,)."""
+        if reach_m <= 0 or reach_m >= self.range_max:
+            return self.no_return  # trusted nowhere (which beams does not matter), or everywhere
+        cache = self.__dict__.setdefault("_open_no_return", {})
+        if reach_m not in cache:
+            nr = self.no_return
+            out = np.zeros(len(nr), dtype=bool)
+            if nr.any():
+                d = np.diff(np.r_[0, nr.astype(np.int8), 0])
+                starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+                idx = self.valid_index
+                k = np.searchsorted(idx, starts)  # the first valid reading after each run
+                r = self.ranges[idx] if len(idx) else np.zeros(1)
+                wide = (ends - starts) * self.angle_increment * reach_m >= OPEN_RUN_MIN_WIDTH_M
+                opens = wide & ((k == 0) | (k == len(idx))  # no reading on one side
+                         | (r[np.clip(k - 1, 0, len(r) - 1)] > reach_m) | (r[np.clip(k, 0, len(r) - 1)] > reach_m))
+                for a, b in zip(starts[opens].tolist(), ends[opens].tolist()):
+                    out[a:b] = True
+            out.setflags(write=False)
+            cache[reach_m] = out
+        return cache[reach_m]
 
     @property
     def n_valid(self) -> int:

@@ -309,6 +309,31 @@ def test_no_return_counts_as_seen_through_only_when_asked():
     assert (short[88:93] == OCCLUDED).all()
 
 
+def test_only_no_return_runs_that_open_onto_free_space_count_as_seen_through():
+    # a wall 2 m away with two patches that return nothing: a narrow one (3 beams, 1.5 deg:
+    # a dropout at 3 m is 8 cm wide) and a wide dark one (20 beams) with the wall on both
+    # sides; beyond the wall's end, nothing in range (an open field)
+    ang = np.radians(np.linspace(-90, 90, 361))
+    r = np.full(361, 2.0)
+    r[100:103] = np.inf
+    r[150:170] = np.inf
+    r[250:] = np.inf
+    before = Scan(r, ang[0], ang[1] - ang[0], 0.05, 10.0, stamp=0.0)
+    open_ = before.open_no_return(3.0)
+    assert not open_[100:103].any()  # narrower than a leg at 3 m: a dropout
+    assert not open_[150:170].any()  # the wall returns on both sides: a dark patch of it
+    assert open_[250:].all()  # a line of sight into the open (no reading beyond it)
+    assert before.open_no_return(0.0)[150:170].all()  # trusted nowhere: the mask does not matter
+    # something now on the dark patch is not seen arriving; someone stepping into the open is
+    now = r.copy()
+    now[155:165] = 1.5
+    now[280:290] = 1.5
+    labels = label_pair(Scan(now, ang[0], ang[1] - ang[0], 0.05, 10.0, stamp=0.1), before, Pose2D(),
+                        DetectorParams(no_return_free_m=3.0))
+    assert not (labels[155:165] == MOVING).any()
+    assert (labels[280:290] == MOVING).all()
+
+
 def test_deskew_keeps_no_return_beams():
     from people_tracker.detection.deskew import deskew
     r = np.full(181, 4.0)
