@@ -27,7 +27,8 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
 
     A beam with no return (``inf``, beyond ``range_max``) saw through everything up to
     ``no_return_free_m`` (m; dark surfaces return nothing either, so a user may trust it
-    only so far, or not at all with 0). A lost
+    only so far, or not at all with 0), when its run of such beams opens onto the open
+    (:meth:`Scan.open_no_return`). A lost
     reading (``nan``, ``0``) tells nothing: surfaces that flicker between a return and none
     (dark, shiny, glass) are exactly what looks moving when it is not. A point outside
     the field of view tells nothing either (False).
@@ -45,8 +46,8 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
     local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
     dist = np.hypot(local[:, 0], local[:, 1])
     if compiled.on:  # the rest, compiled
-        return _seen_through_kernel(local, dist, scan.ranges, _seen_through_beams(scan, no_return_free_m), scan.angle_min, scan.angle_increment,
-                            scan.range_min, margin_m, moving is not None,
+        return _seen_through_kernel(local, dist, scan.ranges, _seen_through_beams(scan, no_return_free_m),
+                            scan.angle_min, scan.angle_increment, scan.range_min, margin_m, moving is not None,
                             moving if moving is not None else scan.no_return, no_return_free_m)
     beam = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
     inside = beam >= 0
@@ -108,17 +109,18 @@ def place_visibility(points_world: np.ndarray, scan: Scan, pose: Pose2D, radius_
     local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
     dist = np.hypot(local[:, 0], local[:, 1])
     if compiled.on:  # the loop below, compiled
-        return _visibility_kernel(local, dist, scan.ranges, scan.valid, _seen_through_beams(scan, no_return_free_m), scan.angle_min,
-                                  scan.angle_increment, radius_m, no_return_free_m)
+        return _visibility_kernel(local, dist, scan.ranges, scan.valid, _seen_through_beams(scan, no_return_free_m),
+                                  scan.angle_min, scan.angle_increment, radius_m, no_return_free_m)
     out = np.full(len(points_world), UNSEEN, dtype=np.int8)
     centre = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
     inc = abs(scan.angle_increment)
+    through = _seen_through_beams(scan, no_return_free_m)
     for k in np.flatnonzero((centre >= 0) & (dist > radius_m)):
         half = int(np.ceil(np.arcsin(min(1.0, radius_m / dist[k])) / inc))
         lo, hi = max(0, centre[k] - half), min(scan.n_beams, centre[k] + half + 1)
         r = scan.ranges[lo:hi]
         valid = scan.valid[lo:hi]
-        free = _seen_through_beams(scan, no_return_free_m)[lo:hi] & (dist[k] + radius_m <= no_return_free_m)
+        free = through[lo:hi] & (dist[k] + radius_m <= no_return_free_m)
         rv = r[valid]
         if (np.abs(rv - dist[k]) <= radius_m).any():
             out[k] = OCCUPIED

@@ -172,9 +172,10 @@ class Scan:
     def open_no_return(self, reach_m: float) -> np.ndarray:
         """Beams with no return (:attr:`no_return`) in a run of them that opens onto free space:
         the nearest valid reading beside the run, on at least one side, lies beyond
-        ``reach_m`` (m), or there is none on that side. A run with a return nearer than that
-        on both sides is a dark or shiny patch of one surface, or lost readings, not a line
-        of sight into the open. With ``reach_m`` at or beyond range_max (the laser trusted to
+        ``reach_m`` (m), or there is none on that side, and the run is at least
+        ``OPEN_RUN_MIN_WIDTH_M`` (a leg) wide at ``reach_m``. A run with a return nearer than
+        that on both sides is a dark or shiny patch of one surface, and a narrower one a
+        dropout (at an edge, say), not a line of sight into the open. With ``reach_m`` at or beyond range_max (the laser trusted to
         return from everything in its range) every beam with no return counts; at 0 or
         below, none is trusted and the mask is :attr:`no_return`. Boolean mask, shape (n,)."""
         if reach_m <= 0 or reach_m >= self.range_max:
@@ -189,7 +190,7 @@ class Scan:
                 idx = self.valid_index
                 k = np.searchsorted(idx, starts)  # the first valid reading after each run
                 r = self.ranges[idx] if len(idx) else np.zeros(1)
-                wide = (ends - starts) * self.angle_increment * reach_m >= OPEN_RUN_MIN_WIDTH_M
+                wide = (ends - starts) * abs(self.angle_increment) * reach_m >= OPEN_RUN_MIN_WIDTH_M
                 opens = wide & ((k == 0) | (k == len(idx))  # no reading on one side
                          | (r[np.clip(k - 1, 0, len(r) - 1)] > reach_m) | (r[np.clip(k, 0, len(r) - 1)] > reach_m))
                 for a, b in zip(starts[opens].tolist(), ends[opens].tolist()):

@@ -324,6 +324,8 @@ def test_only_no_return_runs_that_open_onto_free_space_count_as_seen_through():
     assert not open_[150:170].any()  # the wall returns on both sides: a dark patch of it
     assert open_[250:].all()  # a line of sight into the open (no reading beyond it)
     assert before.open_no_return(0.0)[150:170].all()  # trusted nowhere: the mask does not matter
+    clockwise = Scan(r, ang[-1], ang[0] - ang[1], 0.05, 10.0, stamp=0.0)  # the same beams, swept the other way
+    assert (clockwise.open_no_return(3.0) == open_).all()
     # something now on the dark patch is not seen arriving; someone stepping into the open is
     now = r.copy()
     now[155:165] = 1.5
