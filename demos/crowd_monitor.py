@@ -21,7 +21,7 @@ import numpy as np
 
 from people_tracker.models.scenario import build_simulation, load_scenario
 from people_tracker.tracker.config import load_config
-from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
+from people_tracker.tracker.people_tracker import PeopleTracker
 
 LINE_X = 7.0  # m, the counting line (world frame)
 ZONES = {"near left": (1, 7, 0, 6), "near right": (1, 7, -6, 0), "far left": (7, 14, 0, 6), "far right": (7, 14, -6, 0)}

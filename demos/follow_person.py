@@ -5,11 +5,15 @@ few trees and posts, turning sharply, stopping, while passers-by cross between t
 robot; sunlight adds spurious short readings. The robot has no odometry: each scan goes
 through the tracker alone (`--follow auto` locks onto the person straight ahead), and the
 robot's velocity command comes from where the tracker says the target is (while the person's
-track coasts, unmarked, from its prediction; when the target is lost, from where it was last
-seen, for up to 10 s). The simulator's truth is used only to
-score the run, with `evaluate`'s following protocol.
+track coasts, unmarked, from its prediction; when the target is lost, from the person's place
+relative to the robot averaged over the last 1.5 s, for up to 10 s: a robot that follows
+someone keeps them at much the same place in front of it, so it drives on as it followed
+them, and the re-lock finds them ahead). The tracker runs with the shipped `outdoors`
+configuration (a line of sight into the open that returned nothing counts as seen through
+to 3 m). The simulator's truth is used only to score the run, with `evaluate`'s following
+protocol.
 
-    python demos/follow_person.py [--laser narrow|wide|long_cw] [--seed N] [--short] [--rrd FILE]
+    python demos/follow_person.py [--laser narrow|wide|long_cw] [--seed N] [--short] [--rrd FILE] [--config NAME|FILE]
 
 Prints the following distance (median, p95, max) and the following figures: the share of
 the person's visible scans with the target on them after the first lock, the scans with the
@@ -30,6 +34,7 @@ from people_tracker.models.robot import Command
 from people_tracker.models.scenario import build_simulation, load_scenario
 from people_tracker.tracker.bench import scene_ground_truth
 from people_tracker.tracker.config import load_config
+from people_tracker.tracker.errors import InputError
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 
@@ -37,7 +42,7 @@ SCENE = "follow_outdoor"
 FOLLOW_DISTANCE_M = 1.0
 MAX_SPEED_MPS = 1.5
 MAX_TURN_RADPS = 1.5
-SEARCH_S = 10.0  # s: with the target lost, the robot drives on to where it was last seen for this long
+SEARCH_S = 10.0  # s: with the target lost, the robot drives on after where the person was lately, this long
 
 
 def steer(target_base: np.ndarray | None) -> Command:
@@ -58,7 +63,14 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--short", action="store_true", help="60 s instead of the scene's 10 minutes (for CI)")
     ap.add_argument("--rrd", default="follow_person.rrd", help="rerun recording to save ('' for none)")
+    ap.add_argument("--config", default="outdoors",
+                    help="the tracker's configuration: a shipped name or a YAML file (default: outdoors)")
     args = ap.parse_args(argv)
+    try:
+        config = load_config(args.config)
+    except InputError as exc:
+        print(f"follow_person: {exc}", file=sys.stderr)
+        return 2
     spec = load_scenario(SCENE)
     # people walk round a robot whose path is worked out before the scene runs; this one is
     # steered live by the tracker, so its footprint is off and people may walk through it
@@ -68,7 +80,7 @@ def main(argv=None) -> int:
     sim, n = build_simulation(spec, seed=args.seed, laser=args.laser)
     sim.driver = None  # the robot moves only by the commands below
     person = sim.target_id
-    tracker = PeopleTracker.from_config(load_config(), follow="auto")
+    tracker = PeopleTracker.from_config(config, follow="auto")
     sink = None
     if args.rrd:
         from people_tracker.tracker.viz_rerun import RerunSink
@@ -98,8 +110,12 @@ def main(argv=None) -> int:
             last_seen = (step.scan.stamp, np.array([tracks[target[0]].x, tracks[target[0]].y]))
             command = steer(sim.mount.transform_points(xy[target[0]][None, :])[0])
         elif last_seen is not None and step.scan.stamp - last_seen[0] <= SEARCH_S:
-            # lost: drive on to where they were last seen, then wait there
-            where = sim.mount.transform_points(pose.inverse().transform_points(last_seen[1][None, :]))[0]
+            # lost: drive on after where the person has been lately relative to the robot (the
+            # selector's averaged place, sensor frame), or, with none, to where they were last
+            # seen (world frame); then wait
+            steady = tracker.selector.steady
+            where = sim.mount.transform_points(
+                steady[None, :] if steady is not None else pose.inverse().transform_points(last_seen[1][None, :]))[0]
             command = steer(where) if np.hypot(*where) > FOLLOW_DISTANCE_M else Command()
         else:
             command = Command()

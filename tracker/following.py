@@ -15,7 +15,7 @@ the one clearly walking as the person last walked, by their world-frame velocity
 following someone has them in front of it, wherever a drifting or turned estimate says
 they went, and the one track near that estimate was more often a passer-by than them. A
 track that walks neither as the person last walked nor as the robot that follows them now
-moves is a passer-by, not them, and takes no id.
+moves is a passer-by, not them: it takes no id, and does not count among those in front.
 """
 
 from __future__ import annotations
@@ -57,8 +57,9 @@ class TargetSelector:
         the re-lock began (:meth:`looked_for`): the robot may have fallen back. With several
         there, the one walking as the person last walked takes the id, when it is clearly
         them: its world-frame velocity within ``same_velocity_mps`` (m/s) of theirs and every
-        other's more than ``other_velocity_mps`` from it (:meth:`_walking_on`). Whoever is
-        chosen must walk as the person could (:meth:`walks_as_expected`).
+        other's more than ``other_velocity_mps`` from it (:meth:`_walking_on`). Only tracks
+        that walk as the person could (:meth:`walks_as_expected`) are looked among: one
+        coming the other way or crossing is not them, and leaves the choice to the others.
     max_walk_change_mps, sensor_velocity_s : float
         A track re-locked onto walks (world-frame velocity) within ``max_walk_change_mps``
         (m/s) of the person's velocity when last seen, or of the sensor's own velocity over
@@ -244,11 +245,11 @@ class TargetSelector:
             best = self.only_one_near(stamp, others)
         elif stamp - self.lost_since >= self.relock_s:  # the person is the one in front of the robot
             looked = self.looked_for(stamp, others)
+            if velocities is not None:  # walking as neither the person nor the robot that follows them: a passer-by
+                looked = [tid for tid in looked if self.walks_as_expected(velocities.get(tid))]
             best = self._first(looked, others, only=True)
             if best is None:
                 best = self._walking_on(looked, velocities)
-            if best is not None and velocities is not None and not self.walks_as_expected(velocities.get(best)):
-                best = None  # walking as neither the person nor the robot that follows them: a passer-by
             if best is not None:  # where they are now is learnt afresh
                 self._forget_place()
         else:

@@ -142,8 +142,12 @@ def test_of_several_in_front_the_one_walking_on_as_the_person_walked_takes_their
         return sel.reacquire(1.3, {7: person, 8: passer_by}, velocities)
 
     assert relock(np.array([1.1, 0.1]), np.array([-1.0, 0.3])) == 7  # the passer-by comes the other way
-    assert relock(np.array([1.1, 0.1]), np.array([0.3, 0.9])) is None  # crossing at 1.1 m/s from their walk: unsure
-    assert relock(np.array([1.5, 0.0]), np.array([-1.0, 0.3])) is None  # neither walks as the person did
+    assert relock(np.array([1.1, 0.1]), np.array([0.4, 0.7])) is None  # 0.9 m/s from their walk: unsure
+    # walking as the person could not (1.1 m/s from their walk; the robot's own is not known):
+    # not them, so the one left in front is
+    assert relock(np.array([1.1, 0.1]), np.array([0.3, 0.9])) == 7
+    assert relock(np.array([1.5, 0.0]), np.array([-1.0, 0.3])) == 7
+    assert relock(np.array([1.5, 0.0]), np.array([0.4, 0.7])) is None  # neither walks as the person did
     assert relock(np.array([1.1, 0.1]), np.array([-1.0, 0.3]), seen_v=None) is None  # their walk is not known
     assert relock(None, None) is None  # no velocities given: nobody
 
