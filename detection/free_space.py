@@ -15,12 +15,6 @@ from people_tracker.models.pose import Pose2D
 from people_tracker.models.scan import Scan
 
 
-def _seen_through_beams(scan: Scan, no_return_free_m: float) -> np.ndarray:
-    """The beams with no return that count as seen through (up to ``no_return_free_m``,
-    m, capped at range_max): those whose run opens onto the open (:meth:`Scan.open_no_return`)."""
-    return scan.open_no_return(min(scan.range_max, no_return_free_m))
-
-
 def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: float,
                  moving: np.ndarray | None = None, no_return_free_m: float = np.inf) -> np.ndarray:
     """Whether ``scan`` (taken at ``pose``, world frame) saw past each point by ``margin_m``.
@@ -46,7 +40,7 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
     local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
     dist = np.hypot(local[:, 0], local[:, 1])
     if compiled.on:  # the rest, compiled
-        return _seen_through_kernel(local, dist, scan.ranges, _seen_through_beams(scan, no_return_free_m),
+        return _seen_through_kernel(local, dist, scan.ranges, scan.open_no_return(no_return_free_m),
                             scan.angle_min, scan.angle_increment, scan.range_min, margin_m, moving is not None,
                             moving if moving is not None else scan.no_return, no_return_free_m)
     beam = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
@@ -54,7 +48,7 @@ def seen_through(points_world: np.ndarray, scan: Scan, pose: Pose2D, margin_m: f
     r = np.full(len(local), -1.0)  # outside the view: neither free nor blocked
     r[inside] = scan.ranges[beam[inside]]
     no_return = np.zeros(len(local), dtype=bool)
-    no_return[inside] = _seen_through_beams(scan, no_return_free_m)[beam[inside]]
+    no_return[inside] = scan.open_no_return(no_return_free_m)[beam[inside]]
     no_return &= dist + margin_m <= no_return_free_m
     beyond = np.isfinite(r) & (r > scan.range_min) & (r > dist + margin_m)
     free = no_return | beyond
@@ -109,12 +103,12 @@ def place_visibility(points_world: np.ndarray, scan: Scan, pose: Pose2D, radius_
     local = pose.inverse().transform_points(np.asarray(points_world, dtype=float))
     dist = np.hypot(local[:, 0], local[:, 1])
     if compiled.on:  # the loop below, compiled
-        return _visibility_kernel(local, dist, scan.ranges, scan.valid, _seen_through_beams(scan, no_return_free_m),
+        return _visibility_kernel(local, dist, scan.ranges, scan.valid, scan.open_no_return(no_return_free_m),
                                   scan.angle_min, scan.angle_increment, radius_m, no_return_free_m)
     out = np.full(len(points_world), UNSEEN, dtype=np.int8)
     centre = bin_to_beams(local, scan.angle_min, scan.angle_increment, scan.n_beams)
     inc = abs(scan.angle_increment)
-    through = _seen_through_beams(scan, no_return_free_m)
+    through = scan.open_no_return(no_return_free_m)
     for k in np.flatnonzero((centre >= 0) & (dist > radius_m)):
         half = int(np.ceil(np.arcsin(min(1.0, radius_m / dist[k])) / inc))
         lo, hi = max(0, centre[k] - half), min(scan.n_beams, centre[k] + half + 1)

@@ -175,9 +175,10 @@ class Scan:
         ``reach_m`` (m), or there is none on that side, and the run is at least
         ``OPEN_RUN_MIN_WIDTH_M`` (a leg) wide at ``reach_m``. A run with a return nearer than
         that on both sides is a dark or shiny patch of one surface, and a narrower one a
-        dropout (at an edge, say), not a line of sight into the open. With ``reach_m`` at or beyond range_max (the laser trusted to
-        return from everything in its range) every beam with no return counts; at 0 or
-        below, none is trusted and the mask is :attr:`no_return`. Boolean mask, shape (n,)."""
+        dropout (at an edge, say), not a line of sight into the open. With ``reach_m`` at or
+        beyond range_max (the laser trusted to return from everything in its range) every
+        beam with no return counts; at 0 or below, none is trusted and the mask is
+        :attr:`no_return`. Boolean mask, shape (n,)."""
         if reach_m <= 0 or reach_m >= self.range_max:
             return self.no_return  # trusted nowhere (which beams does not matter), or everywhere
         cache = self.__dict__.setdefault("_open_no_return", {})
