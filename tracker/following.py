@@ -10,15 +10,14 @@ coasts while a fresh track appears where the person should be, the person's id g
 track at that place — when exactly one is there; when more than one could be them, the
 person is reported lost rather than swapped for someone else. An ``auto`` selector (the
 robot follows whoever it locked onto in front of it) gives a lost person's id instead to
-the one person in the robot's way after a moment, if there is exactly one (of several,
+the one person in front of the robot after a moment, if there is exactly one (of several,
 the one clearly walking as the person last walked, by their world-frame velocity): a robot
-following someone has them in front of it, close to the line it drives along (it has been
-aiming at them), wherever a drifting or turned estimate says they went, and the one track
-near that estimate was more often a passer-by than them. A track that walks neither as the
-person last walked nor as the robot that follows them now moves is a passer-by, not them:
-it takes no id, and does not count among those in front. An ``auto`` selector never gives
-the person up: however long they are gone, the next one in the robot's way that way is
-taken as them, under their id.
+following someone has them in front of it, wherever a drifting or turned estimate says
+they went, and the one track near that estimate was more often a passer-by than them. A
+track that walks neither as the person last walked nor as the robot that follows them now
+moves is a passer-by, not them: it takes no id, and does not count among those in front.
+An ``auto`` selector never gives the person up: however long they are gone, the next one
+found in front of the robot, as above, is taken as them, under their id.
 """
 
 from __future__ import annotations
@@ -56,12 +55,8 @@ class TargetSelector:
         zone ahead (none when there are several) takes their id, and their place is learnt
         afresh from them. Beyond the zone's ``lock_range_m``, a track within reach of where
         they should be counts too, out to their last range plus the reach they had when
-        the re-lock began (:meth:`looked_for`): the robot may have fallen back. While the
-        sensor moves at ``driving_mps`` (m/s) or more, only tracks within ``relock_lane_m``
-        (m) of its x axis count: a robot driving after the person aims at them, so they are
-        close to the line it drives along, where a passer-by at the side of the zone is not
-        (the first lock's ``lane_m`` is wider: then the robot has not aimed at anyone yet; a
-        robot standing still may be watching them walk by). With several there, the one walking as the person last walked takes the id, when it is clearly
+        the re-lock began (:meth:`looked_for`): the robot may have fallen back. With several
+        there, the one walking as the person last walked takes the id, when it is clearly
         them: its world-frame velocity within ``same_velocity_mps`` (m/s) of theirs and every
         other's more than ``other_velocity_mps`` from it (:meth:`_walking_on`). Only tracks
         that walk as the person could (:meth:`walks_as_expected`) are looked among: one
@@ -106,15 +101,13 @@ class TargetSelector:
                  slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35,
                  lane_m: float = 0.75, same_velocity_mps: float = 0.2, other_velocity_mps: float = 1.2,
                  max_walk_change_mps: float | None = 1.0, sensor_velocity_s: float = 0.5,
-                 trail_s: float = 1.0, settle_s: float = 2.0, settle_margin_m: float = 0.2,
-                 relock_lane_m: float = 0.5, driving_mps: float = 0.2) -> None:
+                 trail_s: float = 1.0, settle_s: float = 2.0, settle_margin_m: float = 0.2) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
         self._ahead_rad, self._lock_range, self.coast_s = math.radians(ahead_deg), lock_range_m, coast_s
         self._max_reach, self._steady_s, self.slide_m = max_reach_m, steady_s, slide_m
         self.relock_s, self._same_person_m, self._lane_m = relock_s, same_person_m, lane_m
-        self._relock_lane_m, self._driving_mps = relock_lane_m, driving_mps
         self.trail_s = trail_s
         self.settle_s, self.settle_margin_m = settle_s, settle_margin_m
         self._locked_at: float | None = None  # when the first lock was made (s)
@@ -282,21 +275,11 @@ class TargetSelector:
                  if abs(math.atan2(y, x)) <= self._ahead_rad and math.hypot(x, y) <= range_m]
         return [tid for _, tid in sorted(ahead, key=lambda rt: rt[0])]
 
-    def driving(self) -> bool:
-        """Whether the sensor moves at ``driving_mps`` or more (its velocity over the last
-        ``sensor_velocity_s``): a robot driving after the person it follows aims at them."""
-        v = self.sensor_velocity()
-        return v is not None and float(np.hypot(*v)) >= self._driving_mps
-
     def looked_for(self, stamp: float, tracks: dict[int, np.ndarray]) -> list[int]:
         """The tracks (id → sensor-frame place, m) among which the re-lock looks for the lost
-        person, closest first (only within ``relock_lane_m`` of the sensor's x axis while the
-        robot drives, :meth:`driving`): those in
-        the follow zone ahead, and beyond it those where the person could be (within reach of
-        where they should be) out to as far as they could have gone before the re-lock: the
-        robot may have fallen back while they were unseen."""
-        if self.driving():
-            tracks = {tid: q for tid, q in tracks.items() if abs(float(q[1])) <= self._relock_lane_m}
+        person, closest first: those in the follow zone ahead, and beyond it those where the
+        person could be (within reach of where they should be) out to as far as they could
+        have gone before the re-lock: the robot may have fallen back while they were unseen."""
         exp = self.expected(stamp)
         if exp is None:
             return self.in_front(tracks)

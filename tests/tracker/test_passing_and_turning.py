@@ -413,32 +413,6 @@ def test_following_starts_with_the_person_in_the_robots_way():
     assert sel.reacquire(62.0, {6: np.array([2.6, 0.2])}) == 6 and sel.target == 4
 
 
-def test_a_person_a_driving_robot_lost_is_looked_for_in_its_way():
-    """Development runs (seeds 1-2, every laser, both following scenes): of the tracks the
-    re-lock chose, the right ones lay within 0.5 m of the sensor's axis in 84-89 %, the wrong
-    ones (passers-by at the side of the zone ahead) in 19-48 %."""
-    def relock(robot_mps, tracks):
-        """The person was seen 2 m straight ahead of a robot driving along x at ``robot_mps``
-        and lost at 1 s; 1.1 s later the re-lock looks among ``tracks`` (sensor frame, m)."""
-        sel = TargetSelector("auto", relock_lane_m=0.5, driving_mps=0.2)
-        sel.target = 1
-        for k in range(22):
-            t = 0.1 * k
-            sel.moved(t, robot_mps * t, 0.0)
-            if k < 10:
-                sel.seen(t, np.array([2.0, 0.0]))
-            elif k == 10:
-                sel.lost(t)
-        return sel.reacquire(2.1, tracks)
-
-    passer_by, person = np.array([1.5, -0.9]), np.array([2.3, 0.2])  # both in the zone ahead
-    assert relock(1.0, {7: passer_by}) is None  # at the side of the driving robot's way: not them
-    assert relock(1.0, {7: passer_by, 8: person}) == 8  # nor in the way of the one who is
-    # a robot standing still may be watching the person walk by: the whole zone ahead, as before
-    assert relock(0.0, {7: passer_by}) == 7
-    assert relock(0.0, {7: passer_by, 8: person}) is None
-
-
 def test_the_first_lock_moves_to_someone_clearly_more_in_the_robots_way_for_a_moment():
     """Development runs (indoors, seeds 1-8 and 16-30, every laser): a passer-by close in
     front, 0.4-0.7 m to one side, was often reported a few tenths of a second before the
