@@ -57,7 +57,7 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
             out[f"no target: the person's track has had no update for {sel.coast_s:g} s (reported lost)"] += 1
         elif any(d <= NEAR_M for d in dist.values()):
             if sel.target is None or sel.lost_since is None:
-                why = "no person being looked for (given up, and they are not ahead)"
+                why = "no person being looked for"
             elif stamp - sel.lost_since < sel.relock_s:
                 why = f"lost for less than {sel.relock_s:g} s"
             else:
