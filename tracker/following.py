@@ -233,11 +233,11 @@ class TargetSelector:
         (``velocities``: id → world-frame velocity, m/s, when known)."""
         if self.lost_since is None or self.target is None:
             return None
-        if self.mode != "auto" and stamp - self.lost_since > self._reacquire_s:
-            self.events.append(f"gave up {self.target}")
-            self.lost_since = None
-            return None
         if self.mode != "auto":  # the id goes to the one track within reach of where they should be
+            if stamp - self.lost_since > self._reacquire_s:
+                self.events.append(f"gave up {self.target}")
+                self.lost_since = None
+                return None
             best = self.only_one_near(stamp, others)
         elif stamp - self.lost_since >= self.relock_s:  # the person is the one in front of the robot
             looked = self.looked_for(stamp, others)
