@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/follow_closed_loop.py [--seeds 1 2 3 4 5 6 7 8] [--lasers wide narrow long_cw] [--jobs 2] [--config NAME|FILE]
 
-Runs ``demos/follow_person.py`` (the robot steered by the tracker's target alone, no
+Runs ``demos/follow_person.py``'s ``run`` (the robot steered by the tracker's target alone, no
 odometry, through the whole of ``follow_outdoor``) once per laser and seed, and prints each
 run's following distance (median and 95th percentile, metres) and the share of the person's
 visible scans with the target on them, then how many runs kept the person for more than
@@ -17,37 +17,50 @@ seeds of the demo are 1-8; 11-15 were first run in the forty-fourth session.
 from __future__ import annotations
 
 import argparse
-import re
-import subprocess
+import importlib.util
 import sys
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+
+import numpy as np
+
+from people_tracker.tracker.config import Config, load_config
+from people_tracker.tracker.errors import InputError
 
 DEMO = Path(__file__).resolve().parents[1] / "demos" / "follow_person.py"
 KEPT_M = 3.0  # m: a following distance under this is the robot keeping up with its person
 
 
-def one_run(laser: str, seed: int, config: str) -> tuple[float, float, float]:
+def _demo():
+    """The demo module (``demos/`` is scripts, not a package)."""
+    spec = importlib.util.spec_from_file_location("follow_person_demo", DEMO)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def one_run(laser: str, seed: int, config: Config) -> tuple[float, float, float]:
     """(median and p95 following distance in m, % of the person's visible scans with the target on them)."""
-    proc = subprocess.run([sys.executable, str(DEMO), "--rrd", "", "--laser", laser, "--seed", str(seed),
-                           "--config", config], capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise SystemExit(f"follow_closed_loop: {laser} seed {seed}: {proc.stderr.strip()}")
-    dist = re.search(r"median ([0-9.]+) m, p95 ([0-9.]+) m", proc.stdout)
-    on = re.search(r"target on person \d+: ([0-9.]+) %", proc.stdout)
-    return float(dist.group(1)), float(dist.group(2)), float(on.group(1))
+    out = _demo().run(laser, seed, config)
+    dist = out["distances_m"]
+    return float(np.median(dist)), float(np.percentile(dist, 95)), 100.0 * out["figures"]["target_on_person"]
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=list(range(1, 9)))
-    ap.add_argument("--lasers", nargs="+", default=["wide", "narrow", "long_cw"])
+    ap.add_argument("--lasers", nargs="+", default=["wide", "narrow", "long_cw"], choices=("wide", "narrow", "long_cw"))
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--config", default="outdoors", help="the tracker's configuration (default: outdoors, as the demo)")
     args = ap.parse_args(argv)
+    try:
+        config = load_config(args.config)
+    except InputError as exc:
+        print(f"follow_closed_loop: {exc}", file=sys.stderr)
+        return 2
     runs = [(laser, seed) for seed in args.seeds for laser in args.lasers]
-    with ThreadPoolExecutor(args.jobs) as pool:
-        results = list(pool.map(lambda run: one_run(*run, args.config), runs))
+    with ProcessPoolExecutor(args.jobs) as pool:
+        results = list(pool.map(one_run, *zip(*runs), [config] * len(runs)))
     print(f"{'laser':8} {'seed':>4} {'median m':>9} {'p95 m':>7} {'on %':>6}")
     for (laser, seed), (median, p95, on) in zip(runs, results):
         print(f"{laser:8} {seed:4d} {median:9.2f} {p95:7.2f} {on:6.1f}")

@@ -33,7 +33,7 @@ import numpy as np
 from people_tracker.models.robot import Command
 from people_tracker.models.scenario import build_simulation, load_scenario
 from people_tracker.tracker.bench import scene_ground_truth
-from people_tracker.tracker.config import load_config
+from people_tracker.tracker.config import Config, load_config
 from people_tracker.tracker.errors import InputError
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
@@ -56,35 +56,31 @@ def steer(target_base: np.ndarray | None) -> Command:
     return Command(v, float(np.clip(2.0 * err, -MAX_TURN_RADPS, MAX_TURN_RADPS)))
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--laser", default="wide", choices=("narrow", "wide", "long_cw"),
-                    help="86 deg 10 Hz 5.6 m; 270 deg 7.5 Hz 11 m; 270 deg 12.5 Hz 29 m clockwise (default: wide)")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--short", action="store_true", help="60 s instead of the scene's 10 minutes (for CI)")
-    ap.add_argument("--rrd", default="follow_person.rrd", help="rerun recording to save ('' for none)")
-    ap.add_argument("--config", default="outdoors",
-                    help="the tracker's configuration: a shipped name or a YAML file (default: outdoors)")
-    args = ap.parse_args(argv)
-    try:
-        config = load_config(args.config)
-    except InputError as exc:
-        print(f"follow_person: {exc}", file=sys.stderr)
-        return 2
+def run(laser: str = "wide", seed: int = 1, config: Config | None = None, short: bool = False,
+        rrd: str = "") -> dict:
+    """One closed-loop run: the robot steered by the tracker's target through ``follow_outdoor``.
+
+    ``config``: the tracker's configuration (a loaded one; None: the shipped ``outdoors``);
+    ``rrd``: a rerun recording to save ('' for none). Returns the scene's scan count and
+    duration (s), the robot-to-person distances (m, one per scan the person exists), the
+    following figures of ``evaluate`` (its result dict), the person's id, the selector's
+    events and the wall time (s).
+    """
+    config = load_config("outdoors") if config is None else config
     spec = load_scenario(SCENE)
     # people walk round a robot whose path is worked out before the scene runs; this one is
     # steered live by the tracker, so its footprint is off and people may walk through it
     spec = {**spec, "robot": {**spec["robot"], "radius_m": 0.0}}
-    if args.short:
+    if short:
         spec = {**spec, "duration_s": 60}
-    sim, n = build_simulation(spec, seed=args.seed, laser=args.laser)
+    sim, n = build_simulation(spec, seed=seed, laser=laser)
     sim.driver = None  # the robot moves only by the commands below
     person = sim.target_id
     tracker = PeopleTracker.from_config(config, follow="auto")
     sink = None
-    if args.rrd:
+    if rrd:
         from people_tracker.tracker.viz_rerun import RerunSink
-        sink = RerunSink(args.rrd, name="follow-person")
+        sink = RerunSink(rrd, name="follow-person")
     command = Command()
     last_seen = None  # (stamp, world position) of the target when last reported
     gaps, rows, truths = [], [], []
@@ -124,10 +120,30 @@ def main(argv=None) -> int:
             gaps.append(math.hypot(truth.torso_world[k, 0] - truth.robot_pose.x, truth.torso_world[k, 1] - truth.robot_pose.y))
     if sink is not None:
         sink.close()
-    r = evaluate(scene_ground_truth(truths)[0], TrackRows.of(rows), "following", target_person=person)
-    g = np.array(gaps)
-    print(f"follow_person: {SCENE}, laser {args.laser}, seed {args.seed}: {n} scans ({n / sim.laser.rate_hz:.0f} s) "
-          f"in {time.perf_counter() - t0:.1f} s, no odometry")
+    figures = evaluate(scene_ground_truth(truths)[0], TrackRows.of(rows), "following", target_person=person)
+    return {"scans": n, "duration_s": n / sim.laser.rate_hz, "distances_m": np.array(gaps), "figures": figures,
+            "person": person, "events": list(tracker.selector.events), "wall_s": time.perf_counter() - t0}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--laser", default="wide", choices=("narrow", "wide", "long_cw"),
+                    help="86 deg 10 Hz 5.6 m; 270 deg 7.5 Hz 11 m; 270 deg 12.5 Hz 29 m clockwise (default: wide)")
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--short", action="store_true", help="60 s instead of the scene's 10 minutes (for CI)")
+    ap.add_argument("--rrd", default="follow_person.rrd", help="rerun recording to save ('' for none)")
+    ap.add_argument("--config", default="outdoors",
+                    help="the tracker's configuration: a shipped name or a YAML file (default: outdoors)")
+    args = ap.parse_args(argv)
+    try:
+        config = load_config(args.config)
+    except InputError as exc:
+        print(f"follow_person: {exc}", file=sys.stderr)
+        return 2
+    out = run(args.laser, args.seed, config, short=args.short, rrd=args.rrd)
+    r, g, person = out["figures"], out["distances_m"], out["person"]
+    print(f"follow_person: {SCENE}, laser {args.laser}, seed {args.seed}: {out['scans']} scans "
+          f"({out['duration_s']:.0f} s) in {out['wall_s']:.1f} s, no odometry")
     print(f"following distance to person {person}: median {np.median(g):.2f} m, p95 {np.percentile(g, 95):.2f} m, "
           f"max {g.max():.2f} m (the controller aims at {FOLLOW_DISTANCE_M} m)")
     lock = "never" if r["first_lock_scan"] is None else f"{r['first_lock_s']:.2f} s after they are first visible"
@@ -136,7 +152,7 @@ def main(argv=None) -> int:
           f"target changes: {r['target_changes']}; first lock: {lock}")
     print(f"over all tracks (Leigh et al.'s following figures): id switches {r['id_switches']}, misses {r['misses']}, "
           f"MOTP {r['motp_m']:.3f} m")
-    print("tracker events: " + (", ".join(tracker.selector.events) or "none"))
+    print("tracker events: " + (", ".join(out["events"]) or "none"))
     if args.rrd:
         print(f"rerun recording: {args.rrd}")
     return 0
