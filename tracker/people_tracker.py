@@ -380,6 +380,11 @@ class PeopleTracker:
         for e, z in zip(lost, found):
             if z is None or np.hypot(*(z - e.xy)) > self.assoc.support_anchor_m:
                 continue
+            # the object found lies within the spawn exclusion of a track (the place was clear
+            # of tracks; what stands near it now may not be): a tracked person's leg, walking past
+            # where someone stood; a track there would be that person twice
+            if not self._clear_of_tracks(z[None])[0]:
+                continue
             # where they were only guessed to stand (lost out of sight), the thing found must
             # look at least as leg-like as the leg model's base rate (as for any track back in
             # view): clutter the view clears on is not them
