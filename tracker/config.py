@@ -113,6 +113,7 @@ class TracksConfig:
     still_after_s: float = field(metadata=_spec(lo=0.0, hi=3600.0))
     still_drift_mps: float = field(metadata=_spec(lo=0.0, hi=100.0))
     min_person_separation_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
+    same_person_after_s: float = field(metadata=_spec(lo=0.0, hi=3600.0))
     unobserved_sensor_speed_mps: float = field(metadata=_spec(lo=0.0, hi=100.0))
     unobserved_sensor_turn_radps: float = field(metadata=_spec(lo=0.0, hi=100.0))
 

@@ -175,6 +175,8 @@ class PeopleTracker:
         self._tracks: list[TrackState] = []
         # each track's places in the sensor frame over the selector's trail_s: (stamp s, place m)
         self._trails: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+        # pairs of walking tracks closer than tracks.min_person_separation_m: since when (s)
+        self._close_since: dict[tuple[TrackState, TrackState], float] = {}
         self._next_id = 1
         self.last: StepResult | None = None
         self.bad_poses = 0  # poses given with a scan that were not finite (the scan was used without)
@@ -872,8 +874,9 @@ class PeopleTracker:
                                                          self.assoc.start_leg_probability)
         self._spawn([c for ci, c in enumerate(candidates) if ci not in used and free[ci]], stamp)
 
-    def _duplicates(self) -> set[int]:
-        """Indices of tracks that slid onto a person standing still who has a track already.
+    def _duplicates(self, stamp: float) -> set[int]:
+        """Indices of tracks that are a person who has a track already: slid onto someone
+        standing still, or walking with someone for ``tracks.same_person_after_s``.
 
         Two people's torsos are never closer than ``tracks.min_person_separation_m``; when a
         track born beside one standing still comes that close, it is the same person twice:
@@ -884,9 +887,14 @@ class PeopleTracker:
         ``pairing.max_leg_separation_m``) and walks on (seen moving within
         ``tracks.still_after_s``, at ``PASSING_MPS`` or faster; passing in front of or behind
         the standing person hides one of them for a moment) is someone passing close by, and
-        stays."""
-        sep = self.track_params.min_person_separation_m
+        stays.
+        Two walking tracks that close for ``tracks.same_person_after_s`` are one person twice
+        (a track on each leg, or one that slid onto them from a passer-by): the one whose
+        place is less certain (the larger trace of its position covariance) goes, unless it
+        is the followed person's."""
+        sep, after_s = self.track_params.min_person_separation_m, self.track_params.same_person_after_s
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
+        close_since, self._close_since = self._close_since, {}
         if len(idx) < 2 or sep <= 0:
             return set()
         xy = np.array([self._tracks[i].position for i in idx])
@@ -894,9 +902,20 @@ class PeopleTracker:
         out = set()
         rows, cols = np.nonzero(d < sep)
         upper = rows < cols  # each pair once, in np.triu's (row-major) order
+        target = self.selector.target if self.selector is not None else None
         for a, b in zip(rows[upper].tolist(), cols[upper].tolist()):
             ta, tb = self._tracks[idx[a]], self._tracks[idx[b]]
-            if not (ta.still or tb.still) or idx[a] in out or idx[b] in out:
+            if idx[a] in out or idx[b] in out:
+                continue
+            if not (ta.still or tb.still):  # two walking: one person twice once they stay this close
+                if after_s <= 0:
+                    continue
+                since = self._close_since[(ta, tb)] = close_since.get((ta, tb), stamp)
+                if stamp - since >= after_s:
+                    young = idx[a] if np.trace(ta.position_cov) > np.trace(tb.position_cov) else idx[b]
+                    if self._tracks[young].track_id == target:
+                        young = idx[b] if young == idx[a] else idx[a]
+                    out.add(young)
                 continue
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
@@ -965,7 +984,7 @@ class PeopleTracker:
                    for u in self._born_beside(t, self._tracks, stamp))
 
     def _delete(self, stamp: float) -> None:
-        duplicates = self._duplicates()
+        duplicates = self._duplicates(stamp)
         dying = [t for i, t in enumerate(self._tracks) if i not in duplicates and (t.dead() or self._set_off(t, stamp))]
         keep = [t for i, t in enumerate(self._tracks) if i not in duplicates and not (t in dying)]
         for t in dying:

@@ -46,6 +46,11 @@ class TrackParams:
         Two people's torsos are never closer than this, metres: a track that comes this
         close to one standing still is that person twice, and the newcomer is deleted; and
         a person standing still takes a moving candidate only this close (setting off).
+    same_person_after_s : float
+        Two walking tracks closer than ``min_person_separation_m`` for this long, seconds,
+        are one person twice (a track on each of their legs, or one that slid onto them from
+        someone passing): the one whose place is less certain goes. Two people passing close
+        come that near for a moment only. 0: never.
     unobserved_sensor_speed_mps, unobserved_sensor_turn_radps : float
         How far off the sensor's own motion may be, as speed (m/s) and turn rate (rad/s),
         while nothing measures it: no odometry, and scan matching failed (nothing in range
@@ -65,6 +70,7 @@ class TrackParams:
     still_after_s: float = 1.0
     still_drift_mps: float = 0.1
     min_person_separation_m: float = 0.35
+    same_person_after_s: float = 1.0
     unobserved_sensor_speed_mps: float = 0.5
     unobserved_sensor_turn_radps: float = 0.5
 
