@@ -912,10 +912,9 @@ class PeopleTracker:
                     continue
                 since = self._close_since[(ta, tb)] = close_since.get((ta, tb), stamp)
                 if stamp - since >= after_s:
-                    young = idx[a] if np.trace(ta.position_cov) > np.trace(tb.position_cov) else idx[b]
-                    if self._tracks[young].track_id == target:
-                        young = idx[b] if young == idx[a] else idx[a]
-                    out.add(young)
+                    goes, stays = (idx[a], idx[b]) if np.trace(ta.position_cov) > np.trace(tb.position_cov) \
+                        else (idx[b], idx[a])
+                    out.add(stays if self._tracks[goes].track_id == target else goes)
                 continue
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
