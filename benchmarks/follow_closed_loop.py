@@ -17,6 +17,7 @@ seeds of the demo are 1-8; 11-15 were first run in the forty-fourth session.
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib.util
 import sys
 from concurrent.futures import ProcessPoolExecutor
@@ -31,8 +32,9 @@ DEMO = Path(__file__).resolve().parents[1] / "demos" / "follow_person.py"
 KEPT_M = 3.0  # m: a following distance under this is the robot keeping up with its person
 
 
+@functools.cache
 def _demo():
-    """The demo module (``demos/`` is scripts, not a package)."""
+    """The demo module (``demos/`` is scripts, not a package), loaded once per process."""
     spec = importlib.util.spec_from_file_location("follow_person_demo", DEMO)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

@@ -243,7 +243,7 @@ class TargetSelector:
             looked = self.looked_for(stamp, others)
             if velocities is not None:  # walking as neither the person nor the robot that follows them: a passer-by
                 looked = [tid for tid in looked if self.walks_as_expected(velocities.get(tid))]
-            best = self._first(looked, others, only=True)
+            best = self._only_one(looked, others)
             if best is None:
                 best = self._walking_on(looked, velocities)
             if best is not None:  # where they are now is learnt afresh
@@ -289,12 +289,12 @@ class TargetSelector:
         return [tid for tid in self.in_front(tracks, far)
                 if math.hypot(*tracks[tid]) <= self._lock_range or math.dist(tracks[tid], where) <= reach]
 
-    def _first(self, ahead: list[int], tracks: dict[int, np.ndarray], only: bool = False) -> int | None:
-        """The first of ``ahead`` (ids of ``tracks``, id → sensor-frame place, m; with
-        ``only``, when the tracks there are one person's), or None."""
+    def _only_one(self, ahead: list[int], tracks: dict[int, np.ndarray]) -> int | None:
+        """The first of ``ahead`` (ids of ``tracks``, id → sensor-frame place, m) when the
+        tracks there are one person's (all within ``same_person_m`` of it), else None."""
         if not ahead:
             return None
-        if only and any(math.dist(tracks[tid], tracks[ahead[0]]) > self._same_person_m for tid in ahead[1:]):
+        if any(math.dist(tracks[tid], tracks[ahead[0]]) > self._same_person_m for tid in ahead[1:]):
             return None
         return ahead[0]
 
