@@ -128,6 +128,21 @@ class StoodPlace:
     l_dyn: float  # their accumulated existence evidence, log-odds
     guess: bool  # only guessed (lost out of sight): what is found there must look like a leg
     came: float  # when they came (their track last moved), s
+    # a guess's places along the hidden stretch of their path (world frame, m, shape (k, 2)):
+    # they stopped somewhere on it; xy is the middle of what is left of it. None: one place, xy
+    along: np.ndarray | None = None
+
+    @property
+    def places(self) -> np.ndarray:
+        """Where they may stand (world frame, m), shape (k, 2)."""
+        return self.xy[None] if self.along is None else self.along
+
+    def narrow(self, left: np.ndarray) -> None:
+        """Keep only the places ``left`` (a mask over :attr:`places`) of a guess's stretch."""
+        if self.along is not None:
+            self.along = self.along[left]
+            if len(self.along):
+                self.xy = self.along.mean(axis=0)
 
 
 # m/s: a track this fast passing close by someone standing is a passer-by, not them twice (a
@@ -309,39 +324,51 @@ class PeopleTracker:
         """A reported walker coasting out of sight whose predicted place comes out into the
         open, and is seen empty, did not walk on there: they turned, or stopped somewhere on
         the hidden stretch of their path, from where they were last seen to the last
-        predicted place that was hidden. The stretch's middle, the best guess of where they
-        stand, goes to the memory of where people stood (if it is still hidden), with their
-        id and evidence, so they are found there again once the view clears; the track
-        itself goes on as before (a walker who turned is found by it). Every other coasting
-        track notes where its prediction is hidden."""
+        predicted place that was hidden. The part of that stretch not seen empty now goes to
+        the memory of where people stood (if some of it is still hidden), with their id and
+        the evidence they had when last seen (what a hidden walker loses is no sign of
+        absence), so they are found there again once the view clears; the track itself goes
+        on as before (a walker who turned is found by it). Every other coasting track notes
+        where its prediction is hidden."""
         walkers = []
         for i, t in enumerate(self._tracks):
             if t.updated_now:
                 continue
             if vis[i] == OCCLUDED:
                 t.hidden_position = t.position.copy()
-            elif vis[i] == SEEN_THROUGH and t.hidden_position is not None and t.reported and t.moved and not t.still:
+            elif vis[i] == SEEN_THROUGH and t.hidden_position is not None and t.confirmed and t.moved and not t.still:
                 walkers.append(t)
         if not walkers:
             return
-        middle = np.array([t.hidden_stretch_middle for t in walkers])
-        hidden = place_visibility(middle, scan, world, self.existence.place_radius_m,
-                                  self.detector.params.no_return_free_m) == OCCLUDED
-        for t, xy, h in zip(walkers, middle, hidden):
-            if h:
-                self._stood.append(StoodPlace(xy, scan.stamp, t.track_id, t.existence.l_dyn, True, t.last_moving_update))
+        stretches = [t.hidden_stretch(self.assoc.support_radius_m) for t in walkers]
+        codes = self._visibility_of(stretches, scan, world)
+        for t, along, c in zip(walkers, stretches, codes):
+            if (c == OCCLUDED).any():
+                e = StoodPlace(along.mean(axis=0), scan.stamp, t.track_id, t.seen_evidence, True,
+                               t.last_moving_update, along)
+                e.narrow(c != SEEN_THROUGH)
+                self._stood.append(e)
             t.hidden_position = None  # once per spell out of sight
+
+    def _visibility_of(self, groups: list[np.ndarray], scan: Scan, world: Pose2D) -> list[np.ndarray]:
+        """:func:`place_visibility` of several groups of places (world frame, m), one call."""
+        codes = place_visibility(np.concatenate(groups), scan, world, self.existence.place_radius_m,
+                                 self.detector.params.no_return_free_m)
+        return np.split(codes, np.cumsum([len(g) for g in groups])[:-1])
 
     def _remember_standing(self, scan: Scan, world: Pose2D) -> None:
         """Remember where reported people who walked in (or arrived) stand still (world frame),
         with their id and evidence, until the place is seen empty or ``place_memory_s`` has
         passed."""
         stamp = scan.stamp
-        stood = self._stood
-        if stood:
-            xy = np.array([e.xy for e in stood])
-            vis = place_visibility(xy, scan, world, self.existence.place_radius_m, self.detector.params.no_return_free_m)
-            stood = [e for e, v in zip(stood, vis) if v != SEEN_THROUGH and e.stamp >= stamp - self.existence.place_memory_s]
+        stood = [e for e in self._stood if e.stamp >= stamp - self.existence.place_memory_s]
+        if stood:  # a place seen empty is forgotten (of a guess's stretch, the part seen empty)
+            kept = []
+            for e, v in zip(stood, self._visibility_of([e.places for e in stood], scan, world)):
+                if (v != SEEN_THROUGH).any():
+                    e.narrow(v != SEEN_THROUGH)
+                    kept.append(e)
+            stood = kept
         alive = {t.track_id for t in self._tracks}
         for t in self._tracks:
             if t.reported and t.existence.walked_or_arrived and t.still and t.place != PlaceMemory.OCCUPIED_ONLY:
@@ -354,8 +381,8 @@ class PeopleTracker:
                 if e is not None:
                     # keep when they first came: a track taken up here again (below) began
                     # standing, so its last move is that re-take, not their arrival
-                    e.xy, e.stamp, e.track_id, e.l_dyn, e.guess = (t.position.copy(), stamp, t.track_id,
-                                                                   t.existence.l_dyn, False)
+                    e.xy, e.stamp, e.track_id, e.l_dyn, e.guess, e.along = (t.position.copy(), stamp, t.track_id,
+                                                                            t.existence.l_dyn, False, None)
                     e.came = min(e.came, t.last_moving_update)
                 else:
                     stood.append(StoodPlace(t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False,
@@ -367,21 +394,28 @@ class PeopleTracker:
         again after their track was lost (someone walked between, the track went with the
         passer-by). They get their id back when it is free, and their evidence. Where they
         were only guessed to stand (:meth:`_remember_hidden_stops`), the object must look like
-        a leg; what the laser saw there before they came, and never saw empty, is furniture,
-        and the place is forgotten."""
+        a leg (on the hidden stretch of their path, the one nearest its middle); what the
+        laser saw there before they came, and never saw empty, is furniture, and the place
+        is forgotten."""
         if not self._stood:
             return
-        clear = self._clear_of_tracks(np.array([e.xy for e in self._stood]))
-        lost = [e for e, c in zip(self._stood, clear) if c]
+        places = [e.places for e in self._stood]
+        clear = np.split(self._clear_of_tracks(np.concatenate(places)), np.cumsum([len(p) for p in places])[:-1])
+        lost = [(e, p[c]) for e, p, c in zip(self._stood, places, clear) if c.any()]
         if not lost:
             return
-        found = self._static_support(np.array([e.xy for e in lost]), scan, world)
+        found = self._static_support(np.concatenate([p for _, p in lost]), scan, world)
         used = {t.track_id for t in self._tracks}
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
         furniture = []
-        for e, z in zip(lost, found):
-            if z is None or np.hypot(*(z - e.xy)) > self.assoc.support_anchor_m:
+        at = 0
+        for e, p in lost:
+            near = [z for z, q in zip(found[at:at + len(p)], p)
+                    if z is not None and np.hypot(*(z - q)) <= self.assoc.support_anchor_m]
+            at += len(p)
+            if not near:
                 continue
+            z = min(near, key=lambda z: np.hypot(*(z - e.xy)))
             # the object found lies within the spawn exclusion of a track (the place was clear
             # of tracks; what stands near it now may not be): a tracked person's leg, walking past
             # where someone stood; a track there would be that person twice
@@ -408,7 +442,7 @@ class PeopleTracker:
             t.last_moving_update = t.last_update - self.track_params.still_after_s  # standing still
             self._tracks.append(t)
             used.add(track_id)
-            e.track_id = track_id
+            e.track_id, e.xy, e.along = track_id, z.copy(), None
         if furniture:
             self._stood = [e for e in self._stood if e not in furniture]  # by identity (eq=False)
 
@@ -996,18 +1030,19 @@ class PeopleTracker:
     def _remember_ended_out_of_sight(self, t: TrackState, stamp: float) -> None:
         """A confirmed walker whose track ends out of sight (its predicted place was hidden
         since its last update, and is hidden or occupied now: not seen empty) may have
-        stopped there, behind whoever hides them: the middle of the hidden stretch of their
-        path goes to the memory of where people stood, as a guess, with their id and the
-        evidence the track had when last updated (as :meth:`_remember_hidden_stops` does for
-        a walker whose predicted place comes out into the open). When the view clears,
-        someone leg-like found there takes their id back (:meth:`_reacquire_standing`); a
-        place seen empty is forgotten."""
-        xy = t.hidden_stretch_middle
-        if not (xy is not None and t.confirmed and t.moved and not t.still and t.visibility in (OCCLUDED, OCCUPIED)):
+        stopped somewhere behind whoever hides them: the hidden stretch of their path goes to
+        the memory of where people stood, as a guess, with their id and the evidence the
+        track had when last updated (as :meth:`_remember_hidden_stops` does for a walker
+        whose predicted place comes out into the open). When the view clears, someone
+        leg-like found on it takes their id back (:meth:`_reacquire_standing`); the part of
+        it seen empty is forgotten."""
+        along = t.hidden_stretch(self.assoc.support_radius_m)
+        if not (along is not None and t.confirmed and t.moved and not t.still and t.visibility in (OCCLUDED, OCCUPIED)):
             return
         if any(e.track_id == t.track_id for e in self._stood):
             return
-        self._stood.append(StoodPlace(xy, stamp, t.track_id, t.seen_evidence, True, t.last_moving_update))
+        self._stood.append(StoodPlace(along.mean(axis=0), stamp, t.track_id, t.seen_evidence, True,
+                                      t.last_moving_update, along))
 
     def _follow(self, world: Pose2D, stamp: float, unreported: list[TrackState] = ()) -> int | None:
         """The followed person's track id (see :mod:`people_tracker.tracker.following`);

@@ -212,14 +212,16 @@ class TrackState:
         elif self.update_kind is None:
             self.update_kind = "static"
 
-    @property
-    def hidden_stretch_middle(self) -> np.ndarray | None:
-        """The middle of the hidden stretch of its path (world frame, m), from where its last
-        update put it to the last predicted place found hidden since: the best guess of where
-        someone who stopped out of sight stands. None when no prediction was found hidden."""
+    def hidden_stretch(self, step_m: float) -> np.ndarray | None:
+        """Places along the hidden stretch of its path (world frame, m, shape (k, 2)), from
+        where its last update put it to the last predicted place found hidden since, both
+        ends included, at most ``step_m`` apart: where someone who stopped out of sight may
+        stand. None when no prediction was found hidden."""
         if self.hidden_position is None:
             return None
-        return 0.5 * (self.seen_position + self.hidden_position)
+        run = self.hidden_position - self.seen_position
+        n = int(np.ceil(np.hypot(*run) / step_m)) + 1 if step_m > 0 else 2
+        return self.seen_position + np.linspace(0.0, 1.0, max(n, 2))[:, None] * run
 
     @property
     def still(self) -> bool:

@@ -598,6 +598,43 @@ def test_a_walker_whose_track_ends_out_of_sight_gets_their_id_back_where_they_st
     assert [u.track_id for u in tracker._tracks] == [7]
 
 
+def test_a_walker_who_stopped_at_the_far_end_of_where_they_were_hidden_gets_their_id_back():
+    """Traced in the waiting room (seed 23, person 10 at 199 s): a walker turned behind
+    someone standing and stopped 0.3 m short of where their coasting track was last found
+    hidden; the track walked on into the open, was seen empty there and ended. The guess
+    of where they stood was the middle of the hidden stretch, 0.59 m from them, beyond
+    static support's reach, so when the view cleared 143 s later they were found only as a
+    stranger. The whole stretch is remembered; the part seen empty is forgotten, and
+    someone leg-like anywhere on the rest takes the id back."""
+    import dataclasses
+
+    from people_tracker.detection.free_space import OCCLUDED
+    from people_tracker.detection.leg_features import leg_candidates
+
+    tracker = PeopleTracker.from_config(load_config())
+    t = _two_tracks()._tracks[0]  # a confirmed walking track (born moving)
+    t.track_id, t.visibility, t.seen_evidence = 7, OCCLUDED, 3.0
+    t.seen_position, t.hidden_position = np.array([2.4, 0.0]), np.array([3.6, 0.0])  # hidden from 2.4 to 3.6 m
+    tracker._remember_ended_out_of_sight(t, 10.0)
+    [e] = tracker._stood
+    assert e.guess and np.allclose(e.xy, [3.0, 0.0])
+    assert len(e.along) >= 4 and np.all(np.diff(e.along[:, 0]) <= tracker.assoc.support_radius_m + 1e-9)
+
+    empty, there = _scan([]), _scan([[3.5, 0.11, 0.06], [3.5, -0.11, 0.06]])  # they stand at 3.5 m
+    for stamp in np.arange(-30.0, 0.0, 1.0):  # the floor seen empty before they came
+        tracker.places.add(dataclasses.replace(empty, stamp=float(stamp)), Pose2D())
+    seen = dataclasses.replace(there, stamp=120.0)
+    assert tracker._static_support(np.array([[3.0, 0.0]]), seen, Pose2D())[0] is None  # not from the middle
+    tracker._remember_standing(seen, Pose2D())  # what the view shows empty of the stretch is forgotten
+    assert e.along[:, 0].min() > 3.0 and e.xy[0] > 3.2
+    legs = leg_candidates(seen)
+    tracker._legs_world, tracker._leg_scores = legs.xy, tracker.leg_model.probability(legs.features)
+    tracker._reacquire_standing(seen, Pose2D())
+    [back] = tracker._tracks
+    assert back.track_id == 7 and np.hypot(*(back.position - [3.5, 0.0])) < 0.1
+    assert e.along is None and not e.guess
+
+
 def test_the_persons_id_given_to_another_track_leaves_their_old_unreported_one():
     """Found in a held-out following run (indoors, laser long_cw, seed 15): the target's track
     went unreported (no update for 2 s) but lived on, and the re-lock gave the person's id to

@@ -441,8 +441,8 @@ def test_a_walker_who_vanishes_behind_someone_is_remembered_where_they_may_stand
     """Traced in the waiting room (seed 23): a walker stopped right behind someone
     standing; their track coasted on into the open beyond, was seen empty there and
     deleted, and when the view cleared minutes later nobody looked for them where they
-    stood. The middle of the hidden stretch of their path is remembered with their id, as
-    a guess that needs something leg-like to be taken up."""
+    stood. The hidden stretch of their path (its middle the best guess) is remembered
+    with their id, as a guess that needs something leg-like to be taken up."""
     from people_tracker.models.pose import Pose2D
 
     tracker = PeopleTracker.from_config(load_config())
@@ -461,6 +461,7 @@ def test_a_walker_who_vanishes_behind_someone_is_remembered_where_they_may_stand
     assert track_id == t.track_id and guess
     # the middle of 3.0,0.5 (last seen) .. 3.0,1.5 (the last prediction that was hidden)
     assert xy == pytest.approx([3.0, 1.0], abs=1e-9)
+    assert np.allclose(tracker._stood[0].along[[0, -1]], [[3.0, 0.5], [3.0, 1.5]])
     assert t.hidden_position is None  # once per spell out of sight
 
 
