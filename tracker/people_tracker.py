@@ -321,7 +321,7 @@ class PeopleTracker:
             t.weigh(int(v), leg)
 
     def _remember_hidden_stops(self, scan: Scan, world: Pose2D, vis: np.ndarray) -> None:
-        """A reported walker coasting out of sight whose predicted place comes out into the
+        """A confirmed walker coasting out of sight whose predicted place comes out into the
         open, and is seen empty, did not walk on there: they turned, or stopped somewhere on
         the hidden stretch of their path, from where they were last seen to the last
         predicted place that was hidden. The part of that stretch not seen empty now goes to
@@ -352,9 +352,8 @@ class PeopleTracker:
 
     def _visibility_of(self, groups: list[np.ndarray], scan: Scan, world: Pose2D) -> list[np.ndarray]:
         """:func:`place_visibility` of several groups of places (world frame, m), one call."""
-        codes = place_visibility(np.concatenate(groups), scan, world, self.existence.place_radius_m,
-                                 self.detector.params.no_return_free_m)
-        return np.split(codes, np.cumsum([len(g) for g in groups])[:-1])
+        return _per_group(place_visibility(np.concatenate(groups), scan, world, self.existence.place_radius_m,
+                                           self.detector.params.no_return_free_m), groups)
 
     def _remember_standing(self, scan: Scan, world: Pose2D) -> None:
         """Remember where reported people who walked in (or arrived) stand still (world frame),
@@ -400,7 +399,7 @@ class PeopleTracker:
         if not self._stood:
             return
         places = [e.places for e in self._stood]
-        clear = np.split(self._clear_of_tracks(np.concatenate(places)), np.cumsum([len(p) for p in places])[:-1])
+        clear = _per_group(self._clear_of_tracks(np.concatenate(places)), places)
         lost = [(e, p[c]) for e, p, c in zip(self._stood, places, clear) if c.any()]
         if not lost:
             return
@@ -408,11 +407,10 @@ class PeopleTracker:
         used = {t.track_id for t in self._tracks}
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
         furniture = []
-        at = 0
-        for e, p in lost:
-            near = [z for z, q in zip(found[at:at + len(p)], p)
+        ends = np.cumsum([len(p) for _, p in lost])
+        for (e, p), end in zip(lost, ends):
+            near = [z for z, q in zip(found[end - len(p):end], p)
                     if z is not None and np.hypot(*(z - q)) <= self.assoc.support_anchor_m]
-            at += len(p)
             if not near:
                 continue
             z = min(near, key=lambda z: np.hypot(*(z - e.xy)))
@@ -1113,6 +1111,11 @@ class PeopleTracker:
         """The track ``t`` goes on under a new id (it is no longer the followed person)."""
         t.track_id, self._next_id = self._next_id, self._next_id + 1
         return None
+
+
+def _per_group(values: np.ndarray, groups: list[np.ndarray]) -> list[np.ndarray]:
+    """``values``, one per row of the ``groups`` concatenated, split back into one array per group."""
+    return np.split(values, np.cumsum([len(g) for g in groups])[:-1])
 
 
 def _within(gap_s: float, limit_s: float) -> float:
