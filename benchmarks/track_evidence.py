@@ -24,6 +24,7 @@ Usage::
     python benchmarks/track_evidence.py --scenes waiting_room --seeds 21
     python benchmarks/track_evidence.py --scenes crowd --duration 1200
     python benchmarks/track_evidence.py --config mine.yaml       # score another configuration
+    python benchmarks/track_evidence.py --scenes waiting_room --seeds 22 --id-changes   # where ids change
 """
 
 from __future__ import annotations
@@ -98,10 +99,39 @@ def ids_per_person(run: SceneRun) -> dict[int, set[int]]:
     a track is one person's at a time, as in CLEAR MOT's matching; someone else's track
     passing close by is not an id of theirs."""
     ids: dict[int, set[int]] = {}
+    for _, _, person, track in _pairs(run):
+        ids.setdefault(person, set()).add(track)
+    return ids
+
+
+def _pairs(run: SceneRun):
+    """(scan index, the scan's rows, person id, track id) for each person and reported track
+    paired in a scan (see :func:`ids_per_person`)."""
     for sel, tr in _scans_with_people(run):
         for i, j in associate(pairwise_distances(tr.torso_sensor, run.rows[sel, 2:4]), NEAR_M, "gnn"):
-            ids.setdefault(int(tr.person_id[i]), set()).add(int(run.rows[sel[j], 1]))
-    return ids
+            yield int(run.rows[sel[0], 0]), sel, int(tr.person_id[i]), int(run.rows[sel[j], 1])
+
+
+def id_changes(run: SceneRun) -> list[str]:
+    """One line per change of a person's track id (paired as in :func:`ids_per_person`): when
+    (s from the first scan), from which id to which, how long before the old id was last
+    theirs, and whether the old track was still reported then (and how far from them, m)."""
+    last: dict[int, tuple[int, float]] = {}
+    out = []
+    for k, sel, person, track in _pairs(run):
+        t = float(run.stamps[k] - run.stamps[0])
+        if person in last and last[person][0] != track:
+            old, since = last[person]
+            rows = run.rows[sel]
+            here = rows[rows[:, 1] == old]
+            tr = run.truths[k]
+            at = tr.torso_sensor[tr.person_id == person][0]
+            where = (f"still reported, {np.hypot(*(here[0, 2:4] - at)):.2f} m from them" if len(here)
+                     else "not reported")
+            out.append(f"  person {person} at {t:.1f} s: id {old} -> {track} ({old} theirs {t - since:.1f} s "
+                       f"before; {where})")
+        last[person] = (track, t)
+    return out
 
 
 def scene_figures(run: SceneRun) -> dict:
@@ -136,7 +166,7 @@ def scene_figures(run: SceneRun) -> dict:
         false_ids += best >= LASTING_S
     return {"result": result, "strict": strict, "minutes": ratios, "ids_per_person": max((len(s) for s in ids.values()), default=0),
             "people_with_more_ids": sum(len(s) > 1 for s in ids.values()), "false_lasting": false_ids,
-            "confidence": r[:, 4], "near": near}
+            "confidence": r[:, 4], "near": near, "id_changes": id_changes(run)}
 
 
 def calibration_table(confidence: np.ndarray, near: np.ndarray, min_samples: int = 100) -> list[str]:
@@ -187,6 +217,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="also run crowd this long (s) when crowd is listed; 0 skips it")
     ap.add_argument("--config", help="a configuration to score instead of the default (a YAML file or a shipped name)")
     ap.add_argument("--jobs", type=int, default=1, help="scene runs at once (each on one core)")
+    ap.add_argument("--id-changes", action="store_true",
+                    help="under each run, every change of a person's track id: when, from which id to which, "
+                         "and whether the old track was still reported")
     args = ap.parse_args(argv)
     load_config(args.config)  # a bad configuration stops here, before any run
     runs = []
@@ -205,6 +238,8 @@ def main(argv: list[str] | None = None) -> int:
         for (name, seed, duration), f in zip(jobs, figures):
             runs.append(f)
             _print_run(name, seed, duration, f)
+            if args.id_changes and f["id_changes"]:
+                print("\n".join(f["id_changes"]), flush=True)
     conf = np.concatenate([f["confidence"] for f in runs]) if runs else np.zeros(0)
     near = np.concatenate([f["near"] for f in runs]) if runs else np.zeros(0, dtype=bool)
     print("\ncalibration of confidence over every run above (share of reported track-scans within "
