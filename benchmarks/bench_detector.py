@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from people_tracker.detection.detector import MovingObjectDetector
-from people_tracker.tracker.config import load_config
+from people_tracker.tracker.config import load_config_or_exit
 from people_tracker.tracker.io.recording import Recording
 
 DEFAULT_BAG = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "leigh" / "general_tracking_moving_1.bag"
@@ -35,7 +35,7 @@ def main(argv=None) -> int:
         print(f"bench_detector: recording '{args.bag}' not found (the real recordings live in ../shared/data)",
               file=sys.stderr)
         return 2
-    config = load_config(args.config)
+    config = load_config_or_exit(args.config, "bench_detector")
     with Recording(args.bag, args.topic, config.odometry) as rec:
         data = [(r.scan, r.pose) for r in rec.scans() if r.scan is not None]
     times = []

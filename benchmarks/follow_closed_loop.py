@@ -25,8 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from people_tracker.tracker.config import Config, load_config
-from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.config import Config, load_config_or_exit
 
 DEMO = Path(__file__).resolve().parents[1] / "demos" / "follow_person.py"
 KEPT_M = 3.0  # m: a following distance under this is the robot keeping up with its person
@@ -55,11 +54,7 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--config", default="outdoors", help="the tracker's configuration (default: outdoors, as the demo)")
     args = ap.parse_args(argv)
-    try:
-        config = load_config(args.config)
-    except InputError as exc:
-        print(f"follow_closed_loop: {exc}", file=sys.stderr)
-        return 2
+    config = load_config_or_exit(args.config, "follow_closed_loop")
     runs = [(laser, seed) for seed in args.seeds for laser in args.lasers]
     with ProcessPoolExecutor(args.jobs) as pool:
         results = list(pool.map(one_run, *zip(*runs), [config] * len(runs)))

@@ -30,7 +30,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from people_tracker.tracker.bench import scene_ground_truth
-from people_tracker.tracker.config import load_config
+from people_tracker.tracker.config import load_config, load_config_or_exit
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.io.ground_truth import GroundTruth
 from people_tracker.tracker.io.simulated import SimulatedSource
@@ -91,7 +91,7 @@ def main(argv=None) -> int:
     ap.add_argument("--no-follow", action="store_true",
                     help="run without --follow: the id switches over all tracks without the selector's renaming")
     args = ap.parse_args(argv)
-    load_config(args.config)  # a bad configuration stops here, before any run
+    load_config_or_exit(args.config, "following")  # a bad configuration stops here, before any run
     jobs = [(s, laser, seed, args.duration, args.config, not args.no_follow) for s in args.scenes
             for laser in args.lasers for seed in args.seeds]
     print(HEADER, flush=True)

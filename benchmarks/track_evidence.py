@@ -38,7 +38,7 @@ import numpy as np
 
 from people_tracker.models.pose import pairwise_distances
 from people_tracker.tracker.association import associate
-from people_tracker.tracker.config import load_config
+from people_tracker.tracker.config import load_config, load_config_or_exit
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.bench import scene_ground_truth
 from people_tracker.tracker.io.simulated import SimulatedSource
@@ -221,7 +221,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="under each run, every change of a person's track id: when, from which id to which, "
                          "and whether the old track was still reported")
     args = ap.parse_args(argv)
-    load_config(args.config)  # a bad configuration stops here, before any run
+    load_config_or_exit(args.config, "track_evidence")  # a bad configuration stops here, before any run
     runs = []
     print(f"{'scene':<22} {'seed':>4} {'scans':>6} {'MOTA %':>7} {'strict':>7} {'IDF1 %':>7} {'IDsw':>5} {'FP':>6} {'misses':>7} "
           f"{'ids/person':>10} {'people>1':>8} {'false>=2s':>9}  reported/visible per minute")

@@ -33,8 +33,7 @@ import numpy as np
 from people_tracker.models.robot import Command
 from people_tracker.models.scenario import build_simulation, load_scenario
 from people_tracker.tracker.bench import scene_ground_truth
-from people_tracker.tracker.config import Config, load_config
-from people_tracker.tracker.errors import InputError
+from people_tracker.tracker.config import Config, load_config, load_config_or_exit
 from people_tracker.tracker.evaluation import TrackRows, evaluate
 from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 
@@ -135,11 +134,7 @@ def main(argv=None) -> int:
     ap.add_argument("--config", default="outdoors",
                     help="the tracker's configuration: a shipped name or a YAML file (default: outdoors)")
     args = ap.parse_args(argv)
-    try:
-        config = load_config(args.config)
-    except InputError as exc:
-        print(f"follow_person: {exc}", file=sys.stderr)
-        return 2
+    config = load_config_or_exit(args.config, "follow_person")
     out = run(args.laser, args.seed, config, short=args.short, rrd=args.rrd)
     r, g, person = out["figures"], out["distances_m"], out["person"]
     print(f"follow_person: {SCENE}, laser {args.laser}, seed {args.seed}: {out['scans']} scans "

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -408,6 +409,16 @@ def load_config(path: str | Path | None = None) -> Config:
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"configuration file '{p}' cannot be read: {exc}") from None
     return config_from_dict(_parse_yaml(text, f"file '{p}'"))
+
+
+def load_config_or_exit(path: str | Path | None, program: str) -> Config:
+    """:func:`load_config` for a script's ``--config``: a bad name, file or configuration is
+    one line on stderr (``program: ...``) and exit status 2, never a traceback."""
+    try:
+        return load_config(path)
+    except InputError as exc:
+        print(f"{program}: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
 
 
 def dump_config(config: Config) -> str:

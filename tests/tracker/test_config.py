@@ -71,3 +71,30 @@ def test_every_minimum_is_at_most_its_maximum(override, words):
     from people_tracker.tracker.errors import InputError
     with pytest.raises(InputError, match=re.escape(words)):
         config_from_dict(override)
+
+
+def test_a_scripts_bad_configuration_is_one_line_and_exit_2(tmp_path, capsys):
+    from people_tracker.tracker.config import load_config_or_exit
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("tracks:\n  same_person_after_s: -1\n")
+    for source in (str(bad), "no_such_configuration"):
+        with pytest.raises(SystemExit) as stop:
+            load_config_or_exit(source, "script")
+        assert stop.value.code == 2
+        err = capsys.readouterr().err
+        assert err.startswith("script: ") and err.count("\n") == 1, err
+    assert load_config_or_exit("outdoors", "script") == load_config("outdoors")
+
+
+@pytest.mark.parametrize("script", ["following.py", "track_evidence.py", "follow_closed_loop.py"])
+def test_the_benchmarks_refuse_a_bad_configuration_in_one_line(tmp_path, script):
+    import subprocess
+    import sys
+    from pathlib import Path
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("tracks:\n  same_person_after_s: -1\n")
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / script
+    proc = subprocess.run([sys.executable, str(path), "--config", str(bad)], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 2 and proc.stdout == "", proc
+    assert proc.stderr.count("\n") == 1 and "same_person_after_s" in proc.stderr, proc.stderr
