@@ -132,6 +132,12 @@ class StoodPlace:
     # they stopped somewhere on it; xy is the middle of what is left of it. None: one place, xy
     along: np.ndarray | None = None
 
+    @classmethod
+    def hidden_stop(cls, t: TrackState, along: np.ndarray, stamp: float) -> "StoodPlace":
+        """A guess of where the walker of track ``t``, lost out of sight, stands: somewhere
+        on ``along`` (the hidden stretch of its path), with the evidence it had when last seen."""
+        return cls(along.mean(axis=0), stamp, t.track_id, t.seen_evidence, True, t.last_moving_update, along)
+
     @property
     def places(self) -> np.ndarray:
         """Where they may stand (world frame, m), shape (k, 2)."""
@@ -344,8 +350,7 @@ class PeopleTracker:
         codes = self._visibility_of(stretches, scan, world)
         for t, along, c in zip(walkers, stretches, codes):
             if (c == OCCLUDED).any():
-                e = StoodPlace(along.mean(axis=0), scan.stamp, t.track_id, t.seen_evidence, True,
-                               t.last_moving_update, along)
+                e = StoodPlace.hidden_stop(t, along, scan.stamp)
                 e.narrow(c != SEEN_THROUGH)
                 self._stood.append(e)
             t.hidden_position = None  # once per spell out of sight
@@ -1039,8 +1044,7 @@ class PeopleTracker:
             return
         if any(e.track_id == t.track_id for e in self._stood):
             return
-        self._stood.append(StoodPlace(along.mean(axis=0), stamp, t.track_id, t.seen_evidence, True,
-                                      t.last_moving_update, along))
+        self._stood.append(StoodPlace.hidden_stop(t, along, stamp))
 
     def _follow(self, world: Pose2D, stamp: float, unreported: list[TrackState] = ()) -> int | None:
         """The followed person's track id (see :mod:`people_tracker.tracker.following`);
