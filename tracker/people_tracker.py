@@ -268,6 +268,7 @@ class PeopleTracker:
         matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
         self._support(scan, world, matched_t)  # 7. static support for the rest
         self._weigh(scan, world)  # 7b. evidence of existence
+        self._walked_off_unseen(scan.stamp)
         self.places.add(scan, world)
         self._remember_standing(scan, world)
         self._reacquire_standing(scan, world)
@@ -392,6 +393,34 @@ class PeopleTracker:
                     stood.append(StoodPlace(t.position.copy(), stamp, t.track_id, t.existence.l_dyn, False,
                                              t.last_moving_update))
         self._stood = stood[-1000:]
+
+    def _walked_off_unseen(self, stamp: float) -> None:
+        """Someone remembered where they stood (:meth:`_remember_standing`, or guessed to
+        stand out of sight), whose track is gone, walks off from there unseen: hidden while
+        they stood, they are first found walking. A walking track confirmed this scan whose
+        first place lies within ``association.recover_radius_m`` of such a place (the reach
+        of someone's first steps, as for a standing track, :meth:`_born_beside`) takes their
+        id before it is first reported, and the place is forgotten (they left it); of
+        several, the nearest place; none when a confirmed track lies nearer where the walking
+        one began, or the walking one has taken the id of someone remembered standing already
+        (:meth:`_hand_over`): that person's first steps."""
+        if not self._stood:
+            return
+        alive = {t.track_id for t in self._tracks}
+        r = self.assoc.recover_radius_m
+        for u in self._tracks:
+            if u.confirmed_at != stamp or u.born_standing or stamp - u.born > SET_OFF_S or u.track_id != u.born_id:
+                continue
+            near = [(float(np.hypot(*(e.xy - u.origin))), k) for k, e in enumerate(self._stood)
+                    if not e.guess and e.track_id not in alive]
+            d, k = min(near, default=(np.inf, -1))
+            # a tracked person nearer where it began explains it better (their own first steps)
+            if d > r or any(t is not u and t.confirmed and np.hypot(*(t.position - u.origin)) <= d
+                            for t in self._tracks):
+                continue
+            e = self._stood.pop(k)
+            u.track_id = e.track_id
+            alive.add(e.track_id)
 
     def _reacquire_standing(self, scan: Scan, world: Pose2D) -> None:
         """A person-sized object where someone stood, and no track there: that person, seen

@@ -102,6 +102,7 @@ class TrackState:
     def __init__(self, track_id: int, x: float, y: float, R: np.ndarray, stamp: float, params: TrackParams,
                  existence: Existence, standing: bool = False) -> None:
         self.track_id = track_id
+        self.born_id = track_id  # its id when it began (another means it took someone's)
         self.params = params
         kf = KalmanFilter(dim_x=4, dim_z=2)
         kf.x = np.array([x, 0.0, y, 0.0])

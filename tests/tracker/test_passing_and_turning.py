@@ -635,6 +635,46 @@ def test_a_walker_who_stopped_at_the_far_end_of_where_they_were_hidden_gets_thei
     assert e.along is None and not e.guess
 
 
+def test_someone_hidden_where_they_stood_longer_than_their_track_lives_keeps_their_id_as_they_walk_off():
+    """Traced in the waiting room (development seeds 74, 77, 80 and 82): someone tracked
+    standing was hidden by a person who came to stand in front of them, for longer than
+    their track survives unseen (about a minute); the place they stood was remembered. When
+    they walked off, still hidden where they had stood, they were first seen walking, a
+    stride from that place, and got a new id. Here person 2 stands in front of person 1
+    for the rest of the run; person 1 leaves after 100 s."""
+    spec = {"duration_s": 112.0, "laser": LASER, "world": {"room": [-1, -6, 9, 6]},
+            "people": [{"id": 1, "path": [[7.0, -4.0], [5.0, 0.0], [5.0, 5.0]], "speed": 1.0, "pauses": {1: 100.0}},
+                       {"id": 2, "path": [[1.0, -5.0], [3.5, 0.0], [1.0, 5.0]], "speed": 1.0, "pauses": {1: 300.0},
+                        "start_s": 1.0}]}
+    ids = _ids_of(spec)
+    assert ids.get(1) is not None and len(ids[1]) == 1 and ids[1] != ids.get(2), ids
+
+
+def test_a_walker_takes_a_remembered_id_only_as_the_first_steps_from_where_they_stood():
+    def case(memory_guess=False, born_at=(3.0, 0.45), someone_at=None, inherited=False):
+        tracker = PeopleTracker.from_config(load_config())
+        tracker._stood = [StoodPlace(np.array([3.0, 0.0]), 0.0, 7, 3.0, memory_guess, -5.0)]
+        tracker._spawn([PersonCandidate(*born_at, 0.05, "leg")], 100.0)
+        u = tracker._tracks[-1]
+        u.confirmed = True  # confirmed this scan
+        if someone_at is not None:  # someone tracked, nearer where the walker began
+            tracker._spawn([PersonCandidate(9.0, 9.0, 0.05, "pair")], 100.0)  # (clear of the spawn exclusion) ...
+            tracker._tracks[-1].kf.x[::2] = someone_at  # ... and put where wanted
+            tracker._tracks[-1].confirmed = True
+        if inherited:
+            u.track_id = 3  # took a standing track's id already
+        tracker._walked_off_unseen(100.0)
+        return u.track_id, len(tracker._stood)
+
+    assert case() == (7, 0)  # their id; the place is forgotten
+    assert case(memory_guess=True)[0] != 7  # only guessed to stand there
+    assert case(born_at=(3.0, 0.9))[0] != 7  # farther than first steps reach
+    assert case(born_at=(3.0, 0.7))[0] == 7
+    assert case(born_at=(3.0, 0.7), someone_at=(3.0, 1.1))[0] != 7  # the tracked one is nearer
+    assert case(born_at=(3.0, 0.7), someone_at=(3.0, 2.0))[0] == 7
+    assert case(inherited=True) == (3, 1)
+
+
 def test_the_persons_id_given_to_another_track_leaves_their_old_unreported_one():
     """Found in a held-out following run (indoors, laser long_cw, seed 15): the target's track
     went unreported (no update for 2 s) but lived on, and the re-lock gave the person's id to
