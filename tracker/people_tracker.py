@@ -395,15 +395,15 @@ class PeopleTracker:
         self._stood = stood[-1000:]
 
     def _walked_off_unseen(self, stamp: float) -> None:
-        """Someone remembered where they stood (:meth:`_remember_standing`, or guessed to
-        stand out of sight), whose track is gone, walks off from there unseen: hidden while
-        they stood, they are first found walking. A walking track confirmed this scan whose
-        first place lies within ``association.recover_radius_m`` of such a place (the reach
-        of someone's first steps, as for a standing track, :meth:`_born_beside`) takes their
-        id before it is first reported, and the place is forgotten (they left it); of
-        several, the nearest place; none when a confirmed track lies nearer where the walking
-        one began, or the walking one has taken the id of someone remembered standing already
-        (:meth:`_hand_over`): that person's first steps."""
+        """Someone remembered where they stood (:meth:`_remember_standing`; not a guess of
+        where a walker lost out of sight stopped), whose track is gone, walks off from there
+        unseen: hidden while they stood, they are first found walking. A walking track
+        confirmed this scan whose first place lies within ``association.recover_radius_m`` of
+        such a place (the reach of someone's first steps, as for a standing track,
+        :meth:`_born_beside`) takes their id before it is first reported, and the place is
+        forgotten (they left it); of several, the nearest place. None does when a confirmed
+        track lies nearer where the walking one began, or the walking one has taken the id
+        of someone standing already (:meth:`_hand_over`): that person's first steps."""
         if not self._stood:
             return
         alive = {t.track_id for t in self._tracks}
