@@ -25,6 +25,7 @@ Usage::
     python benchmarks/track_evidence.py --scenes crowd --duration 1200
     python benchmarks/track_evidence.py --config mine.yaml       # score another configuration
     python benchmarks/track_evidence.py --scenes waiting_room --seeds 22 --id-changes   # where ids change
+    python benchmarks/track_evidence.py --scenes waiting_room --seeds 70 --untracked    # who went untracked, when
 """
 
 from __future__ import annotations
@@ -134,6 +135,32 @@ def id_changes(run: SceneRun) -> list[str]:
     return out
 
 
+def untracked_spells(run: SceneRun, min_s: float = LASTING_S) -> list[str]:
+    """One line per spell of at least ``min_s`` seconds in which a person was visible and
+    paired with no reported track (as in :func:`ids_per_person`): who, from when to when
+    (s from the first scan) and how many of their visible scans it held. A spell ends when
+    they are tracked again or hidden."""
+    paired: dict[int, set[int]] = {}
+    for k, _, person, _ in _pairs(run):
+        paired.setdefault(k, set()).add(person)
+    open_: dict[int, list] = {}  # person -> [first scan index, last scan index, scans]
+    spells = []
+    for k, tr in enumerate(run.truths):
+        missed = {int(p) for p, v in zip(tr.person_id, tr.visible) if v} - paired.get(k, set())
+        for person in list(open_):
+            if person not in missed:
+                spells.append((person, *open_.pop(person)))
+        for person in missed:
+            if person in open_:
+                open_[person][1:] = [k, open_[person][2] + 1]
+            else:
+                open_[person] = [k, k, 1]
+    spells += [(person, *v) for person, v in open_.items()]
+    t = run.stamps - run.stamps[0]
+    return [f"  person {person} untracked {t[a]:.1f}-{t[b]:.1f} s ({n} visible scans)"
+            for person, a, b, n in sorted(spells, key=lambda s: s[1]) if t[b] - t[a] >= min_s]
+
+
 def scene_figures(run: SceneRun) -> dict:
     r = run.rows
     gt, hidden = scene_ground_truth(run.truths)  # the visible people and the hidden ones
@@ -166,7 +193,7 @@ def scene_figures(run: SceneRun) -> dict:
         false_ids += best >= LASTING_S
     return {"result": result, "strict": strict, "minutes": ratios, "ids_per_person": max((len(s) for s in ids.values()), default=0),
             "people_with_more_ids": sum(len(s) > 1 for s in ids.values()), "false_lasting": false_ids,
-            "confidence": r[:, 4], "near": near, "id_changes": id_changes(run)}
+            "confidence": r[:, 4], "near": near, "id_changes": id_changes(run), "untracked": untracked_spells(run)}
 
 
 def calibration_table(confidence: np.ndarray, near: np.ndarray, min_samples: int = 100) -> list[str]:
@@ -220,6 +247,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--id-changes", action="store_true",
                     help="under each run, every change of a person's track id: when, from which id to which, "
                          "and whether the old track was still reported")
+    ap.add_argument("--untracked", action="store_true",
+                    help=f"under each run, every spell of {LASTING_S:g} s or more in which someone visible had no "
+                         "track: who, when, and how many of their visible scans")
     args = ap.parse_args(argv)
     load_config_or_exit(args.config, "track_evidence")  # a bad configuration stops here, before any run
     runs = []
@@ -240,6 +270,8 @@ def main(argv: list[str] | None = None) -> int:
             _print_run(name, seed, duration, f)
             if args.id_changes and f["id_changes"]:
                 print("\n".join(f["id_changes"]), flush=True)
+            if args.untracked and f["untracked"]:
+                print("\n".join(f["untracked"]), flush=True)
     conf = np.concatenate([f["confidence"] for f in runs]) if runs else np.zeros(0)
     near = np.concatenate([f["near"] for f in runs]) if runs else np.zeros(0, dtype=bool)
     print("\ncalibration of confidence over every run above (share of reported track-scans within "

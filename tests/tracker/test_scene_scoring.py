@@ -1,5 +1,5 @@
 """The scene-scoring helpers of ``benchmarks/track_evidence.py``: which ids each person was given,
-and when a person's id changed."""
+when a person's id changed, and when someone visible went untracked."""
 
 import sys
 from pathlib import Path
@@ -8,7 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-from track_evidence import SceneRun, id_changes, ids_per_person  # noqa: E402
+from track_evidence import SceneRun, id_changes, ids_per_person, untracked_spells  # noqa: E402
 
 
 def _run():
@@ -33,3 +33,17 @@ def test_a_person_who_keeps_their_id_has_no_change():
     run.rows[:, 1] = 7
     run.rows = run.rows[[0, 1, 2, 4]]  # one track on them throughout
     assert ids_per_person(run) == {1: {7}} and id_changes(run) == []
+
+
+def test_spells_in_which_someone_visible_had_no_track():
+    run = _run()
+    assert untracked_spells(run, min_s=0.0) == ["  person 1 untracked 0.2-0.2 s (1 visible scans)"]
+    assert untracked_spells(run, min_s=0.1) == []  # shorter than asked
+    run.rows = run.rows[run.rows[:, 0] >= 3]  # nothing on them in scans 0-2 ...
+    run.truths[1].visible = np.array([False])  # ... hidden in scan 1: two spells
+    assert untracked_spells(run, min_s=0.0) == ["  person 1 untracked 0.0-0.0 s (1 visible scans)",
+                                                "  person 1 untracked 0.2-0.2 s (1 visible scans)"]
+    run.truths[1].visible = np.array([True])
+    assert untracked_spells(run, min_s=0.2) == ["  person 1 untracked 0.0-0.2 s (3 visible scans)"]
+    run.rows = run.rows[:0]  # never tracked: the spell runs to the end
+    assert untracked_spells(run, min_s=0.0) == ["  person 1 untracked 0.0-0.4 s (5 visible scans)"]
