@@ -268,7 +268,7 @@ class PeopleTracker:
         matched_t = {ti for ti, _ in matched} | self._update_standing(standing)
         self._support(scan, world, matched_t)  # 7. static support for the rest
         self._weigh(scan, world)  # 7b. evidence of existence
-        self._walked_off_unseen(scan.stamp)
+        self._walked_off_unseen(scan.stamp)  # 7c. a walker confirmed where someone stood hidden: them
         self.places.add(scan, world)
         self._remember_standing(scan, world)
         self._reacquire_standing(scan, world)
