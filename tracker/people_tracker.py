@@ -437,13 +437,13 @@ class PeopleTracker:
         lost = [(e, p[c]) for e, p, c in zip(self._stood, places, clear) if c.any()]
         if not lost:
             return
-        found = self._static_support(np.concatenate([p for _, p in lost]), scan, world)
+        searched = [p for _, p in lost]
+        found = _per_group(self._static_support(np.concatenate(searched), scan, world), searched)
         used = {t.track_id for t in self._tracks}
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
         furniture = []
-        ends = np.cumsum([len(p) for _, p in lost])
-        for (e, p), end in zip(lost, ends):
-            near = [z for z, q in zip(found[end - len(p):end], p)
+        for (e, p), zs in zip(lost, found):
+            near = [z for z, q in zip(zs, p)
                     if z is not None and np.hypot(*(z - q)) <= self.assoc.support_anchor_m]
             if not near:
                 continue
@@ -1146,9 +1146,11 @@ class PeopleTracker:
         return None
 
 
-def _per_group(values: np.ndarray, groups: list[np.ndarray]) -> list[np.ndarray]:
-    """``values``, one per row of the ``groups`` concatenated, split back into one array per group."""
-    return np.split(values, np.cumsum([len(g) for g in groups])[:-1])
+def _per_group(values, groups: list[np.ndarray]) -> list:
+    """``values`` (an array or a list), one per row of the ``groups`` concatenated, split back
+    into one slice per group."""
+    ends = np.cumsum([len(g) for g in groups])
+    return [values[end - len(g):end] for g, end in zip(groups, ends)]
 
 
 def _within(gap_s: float, limit_s: float) -> float:
