@@ -86,9 +86,10 @@ class TargetSelector:
         who moves relative to the sensor (:meth:`came_from_elsewhere`).
     settle_s, settle_margin_m : float
         ``auto``: for ``settle_s`` seconds after the first lock, a reported person in the lane
-        more nearly straight ahead than the target by at least ``settle_margin_m`` metres takes
-        the target, unless their offset from the axis changed by more than that over the last
-        ``trail_s`` (or since they began): someone crossing the robot's way passes its axis.
+        more nearly straight ahead than the target by at least ``settle_margin_m`` metres (any
+        one in the lane, once the target is beside or behind the sensor) takes the target,
+        unless their offset from the axis changed by more than that over the last ``trail_s``
+        (or since they began): someone crossing the robot's way passes its axis.
         The choice is still being made: whoever is reported first is not always the one in the
         robot's way. A passer-by close in front is seen moving at once, while the person to
         follow, walking away from the laser in their own shadow, may be confirmed a few tenths
@@ -289,6 +290,13 @@ class TargetSelector:
         return [tid for tid in self.in_front(tracks, far)
                 if math.hypot(*tracks[tid]) <= self._lock_range or math.dist(tracks[tid], where) <= reach]
 
+    def _off_axis(self, q: np.ndarray) -> float:
+        """How far a place ``q`` (sensor frame, m) lies off the sensor's axis, m: infinite
+        beside or behind the sensor (outside the follow zone's bearings), where nobody is in
+        the robot's way."""
+        x, y = float(q[0]), float(q[1])
+        return abs(y) if abs(math.atan2(y, x)) <= self._ahead_rad else math.inf
+
     def _only_one(self, ahead: list[int], tracks: dict[int, np.ndarray]) -> int | None:
         """The first of ``ahead`` (ids of ``tracks``, id → sensor-frame place, m) when the
         tracks there are one person's (all within ``same_person_m`` of it), else None."""
@@ -315,9 +323,10 @@ class TargetSelector:
         lane = [tid for tid, off in aside.items() if off <= self._lane_m]
         best = min(lane, key=lambda tid: (aside[tid], tid)) if lane else None
         if settling:  # someone clearly more in the robot's way than the target takes it
+            # (a target gone beside or behind the sensor is in nobody's way) ...
             # ... and stays there (someone crossing the robot's way passes its axis)
-            if (best is None or best == self.target or self.target not in aside
-                    or aside[best] + self.settle_margin_m > aside[self.target]
+            if (best is None or best == self.target or self.target not in reported
+                    or aside[best] + self.settle_margin_m > self._off_axis(reported[self.target])
                     or (then and best in then
                         and abs(float(reported[best][1] - then[best][1])) > self.settle_margin_m)):
                 return self.target
