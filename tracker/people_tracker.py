@@ -566,8 +566,10 @@ class PeopleTracker:
         where an earlier scan saw them, so the detector labels their readings revealed
         (``OCCLUDED``), not moving, and their legs often give no moving object; a passer-by
         coming the other way beside them does, and would take their track. For each
-        confirmed walking track whose velocity points away from the sensor at ``PASSING_MPS``
-        or faster, a person-sized group of the readings at its prediction (no moving
+        walking track whose velocity points away from the sensor at ``PASSING_MPS`` or
+        faster, and each tentative one whose velocity is not learnt yet (slower than that:
+        a new track begins with none, and someone walking away in their own shadow gives it
+        no moving object to learn it from), a person-sized group of the readings at its prediction (no moving
         object's; as static support finds it) holding at least ``support_min_points``
         revealed readings is a candidate, with a single leg's σ, when a leg candidate the leg
         model finds at least ``standing.min_leg_probability`` leg-like lies within half a
@@ -578,12 +580,14 @@ class PeopleTracker:
         someone standing is not revealed behind themselves."""
         if not self.assoc.receding:
             return []
-        walkers = [t for t in self._tracks if t.confirmed and t.moved and not t.still]
+        walkers = [t for t in self._tracks if t.moved and not t.still]
         if walkers:  # walking away from the laser: only then is a walker revealed behind where they were
             sensor = np.array([world.x, world.y])
             away = [float(np.dot(t.velocity, t.position - sensor)) / max(float(np.hypot(*(t.position - sensor))), 1e-6)
                     for t in walkers]
-            walkers = [t for t, v in zip(walkers, away) if v >= PASSING_MPS]
+            # a new walker whose velocity is not learnt yet may be walking away in their own shadow
+            walkers = [t for t, v in zip(walkers, away) if v >= PASSING_MPS
+                       or (not t.confirmed and float(np.hypot(*t.velocity)) < PASSING_MPS)]
         if not walkers:
             return []
         found = self._static_support(np.array([t.position for t in walkers]), scan, world,
