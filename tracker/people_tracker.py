@@ -68,8 +68,9 @@ class AssociationParams:
         from a robot that follows them stays in their own shadow, and outdoors nothing
         behind them returns a reading to see past.
     receding : bool
-        A confirmed walking track moving away from the laser at ``PASSING_MPS`` or faster
-        may take, as a moving candidate, a person-sized group of the readings at its
+        A confirmed walking track moving away from the laser at ``PASSING_MPS`` or faster,
+        or a tentative one whose velocity is not learnt yet (slower than that), may take,
+        as a moving candidate, a person-sized group of the readings at its
         prediction that belong to no moving object and hold at least
         ``support_min_points`` readings the detector labelled ``OCCLUDED`` and lying by a
         leg-shaped segment (see :meth:`PeopleTracker._receding`). On by default.
