@@ -68,9 +68,8 @@ class AssociationParams:
         from a robot that follows them stays in their own shadow, and outdoors nothing
         behind them returns a reading to see past.
     receding : bool
-        A confirmed walking track moving away from the laser at ``PASSING_MPS`` or faster,
-        or a tentative one whose velocity is not learnt yet (slower than that), may take,
-        as a moving candidate, a person-sized group of the readings at its
+        A confirmed walking track moving away from the laser at ``PASSING_MPS`` or faster
+        may take, as a moving candidate, a person-sized group of the readings at its
         prediction that belong to no moving object and hold at least
         ``support_min_points`` readings the detector labelled ``OCCLUDED`` and lying by a
         leg-shaped segment (see :meth:`PeopleTracker._receding`). On by default.
@@ -567,10 +566,8 @@ class PeopleTracker:
         where an earlier scan saw them, so the detector labels their readings revealed
         (``OCCLUDED``), not moving, and their legs often give no moving object; a passer-by
         coming the other way beside them does, and would take their track. For each
-        walking track whose velocity points away from the sensor at ``PASSING_MPS`` or
-        faster, and each tentative one whose velocity is not learnt yet (slower than that:
-        a new track begins with none, and someone walking away in their own shadow gives it
-        no moving object to learn it from), a person-sized group of the readings at its prediction (no moving
+        confirmed walking track whose velocity points away from the sensor at ``PASSING_MPS``
+        or faster, a person-sized group of the readings at its prediction (no moving
         object's; as static support finds it) holding at least ``support_min_points``
         revealed readings is a candidate, with a single leg's σ, when a leg candidate the leg
         model finds at least ``standing.min_leg_probability`` leg-like lies within half a
@@ -581,14 +578,12 @@ class PeopleTracker:
         someone standing is not revealed behind themselves."""
         if not self.assoc.receding:
             return []
-        walkers = [t for t in self._tracks if t.moved and not t.still]
+        walkers = [t for t in self._tracks if t.confirmed and t.moved and not t.still]
         if walkers:  # walking away from the laser: only then is a walker revealed behind where they were
             sensor = np.array([world.x, world.y])
             away = [float(np.dot(t.velocity, t.position - sensor)) / max(float(np.hypot(*(t.position - sensor))), 1e-6)
                     for t in walkers]
-            # a new walker whose velocity is not learnt yet may be walking away in their own shadow
-            walkers = [t for t, v in zip(walkers, away) if v >= PASSING_MPS
-                       or (not t.confirmed and float(np.hypot(*t.velocity)) < PASSING_MPS)]
+            walkers = [t for t, v in zip(walkers, away) if v >= PASSING_MPS]
         if not walkers:
             return []
         found = self._static_support(np.array([t.position for t in walkers]), scan, world,
