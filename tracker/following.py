@@ -273,7 +273,7 @@ class TargetSelector:
         by default ``lock_range_m``), closest first."""
         range_m = self._lock_range if range_m is None else range_m
         ahead = [(math.hypot(x, y), tid) for tid, (x, y) in tracks.items()
-                 if abs(math.atan2(y, x)) <= self._ahead_rad and math.hypot(x, y) <= range_m]
+                 if self._within_bearings(x, y) and math.hypot(x, y) <= range_m]
         return [tid for _, tid in sorted(ahead, key=lambda rt: rt[0])]
 
     def looked_for(self, stamp: float, tracks: dict[int, np.ndarray]) -> list[int]:
@@ -290,12 +290,16 @@ class TargetSelector:
         return [tid for tid in self.in_front(tracks, far)
                 if math.hypot(*tracks[tid]) <= self._lock_range or math.dist(tracks[tid], where) <= reach]
 
+    def _within_bearings(self, x: float, y: float) -> bool:
+        """Whether a place (sensor frame, m) lies within the follow zone's bearings."""
+        return abs(math.atan2(y, x)) <= self._ahead_rad
+
     def _off_axis(self, q: np.ndarray) -> float:
         """How far a place ``q`` (sensor frame, m) lies off the sensor's axis, m: infinite
         beside or behind the sensor (outside the follow zone's bearings), where nobody is in
         the robot's way."""
         x, y = float(q[0]), float(q[1])
-        return abs(y) if abs(math.atan2(y, x)) <= self._ahead_rad else math.inf
+        return abs(y) if self._within_bearings(x, y) else math.inf
 
     def _only_one(self, ahead: list[int], tracks: dict[int, np.ndarray]) -> int | None:
         """The first of ``ahead`` (ids of ``tracks``, id → sensor-frame place, m) when the
