@@ -78,7 +78,11 @@ class TargetSelector:
         The person's place relative to the sensor averaged over ``steady_s`` seconds: a
         target track that moved more than ``slide_m`` from it, while exactly one other track
         was updated within ``reacquire_m`` of it, slid onto someone passing between; the
-        person is lost (and the re-lock looks for them).
+        person is lost (and the re-lock looks for them). A target back from coasting
+        (``coast_s``) more than ``slide_m`` from the average is not learnt into it until it
+        has stayed off for ``steady_s``: after a gap the average would take a large share of
+        the jump at once, and a track that came back on a passer-by would drag the person's
+        place onto them before the person's own new track is seen where they are.
     trail_s : float
         ... unless that other track was farther than ``reacquire_m`` from the averaged place
         ``trail_s`` seconds ago (or where it began, if later): it walked in from elsewhere, a
@@ -113,6 +117,7 @@ class TargetSelector:
         self.settle_s, self.settle_margin_m = settle_s, settle_margin_m
         self._locked_at: float | None = None  # when the first lock was made (s)
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
+        self._slid_since: float | None = None  # since when (s) the target's updates have been off ``steady``
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
         self._v = np.zeros(2)  # ... its rate of change (m/s) ...
         self._t: float | None = None  # ... and when their track was last updated (s)
@@ -138,9 +143,15 @@ class TargetSelector:
                 rate *= 2.0 / speed
             self._v = 0.7 * self._v + 0.3 * rate
             a = 1.0 - math.exp(-(stamp - self._t) / self._steady_s)
+            if not self.slid(q):
+                self._slid_since = None
+            elif self._slid_since is None and self.coasting(stamp, self._t):
+                self._slid_since = stamp  # back from coasting somewhere off where the person has been
+            if self._slid_since is not None and stamp - self._slid_since < self._steady_s:
+                a = 0.0  # not learnt until it has stayed off for steady_s
             self.steady = self.steady + a * (q - self.steady)
         else:
-            self.steady = q.copy()
+            self.steady, self._slid_since = q.copy(), None
         self._q, self._t, self._yaw = q.copy(), stamp, self.yaw
         self.lost_since = None
 
@@ -175,7 +186,7 @@ class TargetSelector:
     def _forget_place(self) -> None:
         """Forget where the person is relative to the sensor (learnt afresh from the next
         track seen as them)."""
-        self._q, self._t, self._v, self.steady = None, None, np.zeros(2), None
+        self._q, self._t, self._v, self.steady, self._slid_since = None, None, np.zeros(2), None, None
 
     def coasting(self, stamp: float, last_update: float) -> bool:
         """Whether a track last updated at ``last_update`` (s) has coasted ``coast_s`` by
