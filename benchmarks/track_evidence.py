@@ -161,7 +161,9 @@ def untracked_spells(run: SceneRun, min_s: float = LASTING_S) -> list[str]:
             for person, a, b, n in sorted(spells, key=lambda s: s[1]) if t[b] - t[a] >= min_s]
 
 
-def scene_figures(run: SceneRun) -> dict:
+def scene_figures(run: SceneRun, id_change_lines: bool = False, untracked_lines: bool = False) -> dict:
+    """The figures of one run; with ``id_change_lines`` / ``untracked_lines`` also the lines of
+    :func:`id_changes` / :func:`untracked_spells` (empty lists otherwise)."""
     r = run.rows
     gt, hidden = scene_ground_truth(run.truths)  # the visible people and the hidden ones
     rows = TrackRows(r[:, 0].astype(np.int64), r[:, 1].astype(np.int64), r[:, 2], r[:, 3])
@@ -193,7 +195,8 @@ def scene_figures(run: SceneRun) -> dict:
         false_ids += best >= LASTING_S
     return {"result": result, "strict": strict, "minutes": ratios, "ids_per_person": max((len(s) for s in ids.values()), default=0),
             "people_with_more_ids": sum(len(s) > 1 for s in ids.values()), "false_lasting": false_ids,
-            "confidence": r[:, 4], "near": near, "id_changes": id_changes(run), "untracked": untracked_spells(run)}
+            "confidence": r[:, 4], "near": near, "id_changes": id_changes(run) if id_change_lines else [],
+            "untracked": untracked_spells(run) if untracked_lines else []}
 
 
 def calibration_table(confidence: np.ndarray, near: np.ndarray, min_samples: int = 100) -> list[str]:
@@ -217,10 +220,11 @@ def calibration_table(confidence: np.ndarray, near: np.ndarray, min_samples: int
 
 
 def _figures(job: tuple) -> dict:
-    """One scene run's figures (a worker process's job): (scene, seed, duration, config path)."""
-    name, seed, duration, config_path = job
+    """One scene run's figures (a worker process's job): (scene, seed, duration, config path,
+    whether to list id changes, whether to list untracked spells)."""
+    name, seed, duration, config_path, id_change_lines, untracked_lines = job
     run = run_scene(name, seed, duration, config=load_config(config_path))
-    return {**scene_figures(run), "scans": len(run.truths)}
+    return {**scene_figures(run, id_change_lines, untracked_lines), "scans": len(run.truths)}
 
 
 def _print_run(name: str, seed: int | None, duration: float | None, f: dict) -> None:
@@ -264,7 +268,8 @@ def main(argv: list[str] | None = None) -> int:
         if name == "crowd" and args.long_crowd > 0 and args.duration is None:
             jobs.append((name, None, args.long_crowd))
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        figures = pool.map(_figures, [(name, seed, duration, args.config) for name, seed, duration in jobs])
+        figures = pool.map(_figures, [(name, seed, duration, args.config, args.id_changes, args.untracked)
+                                      for name, seed, duration in jobs])
         for (name, seed, duration), f in zip(jobs, figures):
             runs.append(f)
             _print_run(name, seed, duration, f)
