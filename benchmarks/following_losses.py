@@ -13,7 +13,10 @@ for the person, the zone ahead and beyond it where they could be: with two or mo
 goes to none, and one that walks as the person could not takes no id either);
 no target while the person's track coasts (no update for the selector's ``coast_s``: it
 is reported as a track, but not marked as the target); no target while only an unreported
-track is on them; no target and no track near them.
+track is on them; no target and no track near them. With ``--spells``, also each spell of a
+second or more with the target on someone or something else while the person is visible
+or the target is on someone: when, how long, on whom, and whether the target's track was the
+one last on the person (it went from them onto someone) or another (the id was given to it).
 The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
 """
 
@@ -32,17 +35,25 @@ from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_senso
 NEAR_M = 0.75  # m: the following protocol's match distance
 
 
-def classify(scene: str, laser: str, seed: int, duration: float | None) -> Counter:
+def classify(scene: str, laser: str, seed: int, duration: float | None,
+             spells: list[str] | None = None, min_spell_s: float = 1.0) -> Counter:
+    """The count of the person's visible scans after the first lock in each class; with a
+    ``spells`` list, one line is added to it per spell of ``min_spell_s`` or more with the
+    target on someone or something else (see the module's text)."""
     source = SimulatedSource(scene, seed=seed, duration=duration, laser=laser)
     tracker = PeopleTracker.from_config(load_config(), follow="auto")
     person, sel = source.sim.target_id, tracker.selector
     out: Counter = Counter()
-    locked = False
+    locked, first = False, None  # first: the first scan's stamp (s)
+    marks = []  # per scan: None without a target, else (stamp s, on the person, its track, on whom, person visible)
     for record in source.scans():
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
         truth = source.truths[record.index]
         k = np.flatnonzero((truth.person_id == person) & truth.visible)
         locked |= any(t.target for t in tracks)
+        first = record.scan.stamp if first is None else first
+        if spells is not None:
+            marks.append(_mark(record.scan.stamp, tracks, tracker, truth, person, bool(len(k))))
         if not len(k) or not locked:
             continue
         here = dict(zip((t.track_id for t in tracks), tracks_in_sensor_frame(tracks, tracker.last.pose)))
@@ -71,26 +82,72 @@ def classify(scene: str, laser: str, seed: int, duration: float | None) -> Count
             out["no target, only an unreported track on them"] += 1
         else:
             out["no target, no track near them"] += 1
+    if spells is not None:
+        spells += _wrong_spells(marks, min_spell_s, first or 0.0)
     return out
 
 
-def one_run_arguments(doc: str, scene: str, seed: int, argv=None) -> argparse.Namespace:
+def _mark(stamp: float, tracks, tracker: PeopleTracker, truth, person: int, visible: bool):
+    """One scan's target for :func:`_wrong_spells`, or None without a target."""
+    target = next((t for t in tracks if t.target), None)
+    if target is None:
+        return None
+    q = tracks_in_sensor_frame([target], tracker.last.pose)[0]
+    d = np.hypot(*(truth.torso_sensor - q).T)
+    j = int(np.argmin(d)) if len(d) else -1
+    whom = int(truth.person_id[j]) if j >= 0 and d[j] <= NEAR_M else None
+    state = next(u for u in tracker._tracks if u.track_id == target.track_id)
+    return stamp, whom == person, state, whom, visible
+
+
+def _wrong_spells(marks: list, min_s: float, t0: float) -> list[str]:
+    """The lines of :func:`classify`'s ``spells`` from its per-scan marks (times from ``t0``, s)."""
+    lines, last_on, n = [], None, 0
+    while n < len(marks):
+        m = marks[n]
+        if m is not None and m[1]:
+            last_on = m
+        if m is None or m[1] or not (m[4] or m[3] is not None):
+            n += 1
+            continue
+        end = n
+        while end + 1 < len(marks) and marks[end + 1] is not None and not marks[end + 1][1]:
+            end += 1
+        spell = marks[n:end + 1]
+        if spell[-1][0] - m[0] >= min_s:
+            whom = Counter("someone or something else" if s[3] is None else f"person {s[3]}" for s in spell)
+            how = ("another track (the person's id given to it)" if last_on is None or last_on[2] is not m[2] else
+                   f"the track last on the person, {m[0] - last_on[0]:.2f} s before")
+            lines.append(f"  {m[0] - t0:7.2f} s  {len(spell):4d} scans  on {', '.join(f'{w} ({c})' for w, c in whom.most_common())}; "
+                         f"{how}")
+        n = end + 1
+    return lines
+
+
+def one_run_arguments(doc: str, scene: str, seed: int, argv=None, spells: bool = False) -> argparse.Namespace:
     """``--scene``, ``--laser``, ``--seed`` and ``--duration`` of one simulated following run."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--scene", default=scene)
     ap.add_argument("--laser", default="wide")
     ap.add_argument("--seed", type=int, default=seed)
     ap.add_argument("--duration", type=float, help="seconds (default: the scene's 10 minutes)")
+    if spells:
+        ap.add_argument("--spells", action="store_true",
+                        help="also list each spell of a second or more with the target on someone or something else")
     return ap.parse_args(argv)
 
 
 def main(argv=None) -> int:
-    args = one_run_arguments(__doc__, "follow_indoor_crowd", 2, argv)
-    counts = classify(args.scene, args.laser, args.seed, args.duration)
+    args = one_run_arguments(__doc__, "follow_indoor_crowd", 2, argv, spells=True)
+    spells: list[str] | None = [] if args.spells else None
+    counts = classify(args.scene, args.laser, args.seed, args.duration, spells)
     total = sum(counts.values())
     print(f"{args.scene}, laser {args.laser}, seed {args.seed}: {total} scans with the person visible after the first lock")
     for what, n in sorted(counts.items(), key=lambda kv: -kv[1]):
         print(f"{100 * n / max(total, 1):6.1f} %  {n:6d}  {what}")
+    if spells is not None:
+        print("spells of 1 s or more with the target on someone or something else (s from the first scan):")
+        print("\n".join(spells) if spells else "  none")
     return 0
 
 

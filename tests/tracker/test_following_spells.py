@@ -1,0 +1,33 @@
+"""The spells of ``benchmarks/following_losses.py --spells``: runs of scans with the followed
+person's target on someone or something else, and how each began."""
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+from following_losses import _wrong_spells  # noqa: E402
+
+
+def _marks(spec):
+    """Scans 0.1 s apart from (track, on whom, person visible) per scan (None: no target);
+    the person is person 1."""
+    return [None if s is None else (0.1 * n, s[1] == 1, s[0], s[1], s[2]) for n, s in enumerate(spec)]
+
+
+def test_a_track_that_goes_from_the_person_onto_someone_and_an_id_given_to_another():
+    a, b = object(), object()
+    spec = ([(a, 1, True)] + [(a, 5, True)] * 12  # a slides from the person onto person 5 for 1.2 s
+            + [None] * 3
+            + [(b, None, True)] * 11  # the id given to b, on nobody, while the person is visible
+            + [(a, 1, True)] + [(a, 5, True)] * 5)  # a short one: left out
+    lines = _wrong_spells(_marks(spec), 1.0, 0.0)
+    assert len(lines) == 2
+    assert "12 scans  on person 5 (12); the track last on the person, 0.10 s before" in lines[0]
+    assert lines[0].strip().startswith("0.10 s")
+    assert "11 scans  on someone or something else (11); another track (the person's id given to it)" in lines[1]
+
+
+def test_a_target_on_nothing_while_the_person_is_hidden_is_no_spell():
+    a = object()
+    spec = [(a, 1, True)] + [(a, None, False)] * 20  # coasting on through the gap: a guess, not wrong
+    assert _wrong_spells(_marks(spec), 1.0, 0.0) == []
