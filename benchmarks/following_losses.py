@@ -16,7 +16,8 @@ is reported as a track, but not marked as the target); no target while only an u
 track is on them; no target and no track near them. With ``--spells``, also each spell of a
 second or more with the target on someone or something else while the person is visible
 or the target is on someone: when, how long, on whom, and whether the target's track was the
-one last on the person (it went from them onto someone) or another (the id was given to it).
+one last on the person (it went from them onto someone) or another (the id was given to it,
+after the loss the selector's event names).
 The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
 """
 
@@ -45,7 +46,8 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
     person, sel = source.sim.target_id, tracker.selector
     out: Counter = Counter()
     locked, first = False, None  # first: the first scan's stamp (s)
-    marks = []  # per scan: None without a target, else (stamp s, on the person, its track, on whom, person visible)
+    marks = []  # per scan: None without a target, else (stamp s, on the person, its track, on whom, person visible,
+    # the selector's last 'lost' event)
     for record in source.scans():
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
         truth = source.truths[record.index]
@@ -97,7 +99,8 @@ def _mark(stamp: float, tracks, tracker: PeopleTracker, truth, person: int, visi
     j = int(np.argmin(d)) if len(d) else -1
     whom = int(truth.person_id[j]) if j >= 0 and d[j] <= NEAR_M else None
     state = next(u for u in tracker._tracks if u.track_id == target.track_id)
-    return stamp, whom == person, state, whom, visible
+    lost = next((e for e in reversed(tracker.selector.events) if e.startswith("lost")), None)
+    return stamp, whom == person, state, whom, visible, lost
 
 
 def _wrong_spells(marks: list, min_s: float, t0: float) -> list[str]:
@@ -116,7 +119,7 @@ def _wrong_spells(marks: list, min_s: float, t0: float) -> list[str]:
         spell = marks[n:end + 1]
         if spell[-1][0] - m[0] >= min_s:
             whom = Counter("someone or something else" if s[3] is None else f"person {s[3]}" for s in spell)
-            how = ("another track (the person's id given to it)" if last_on is None or last_on[2] is not m[2] else
+            how = (f"another track (the person's id given to it after '{m[5]}')" if last_on is None or last_on[2] is not m[2] else
                    f"the track last on the person, {m[0] - last_on[0]:.2f} s before")
             lines.append(f"  {m[0] - t0:7.2f} s  {len(spell):4d} scans  on {', '.join(f'{w} ({c})' for w, c in whom.most_common())}; "
                          f"{how}")

@@ -193,11 +193,12 @@ class TargetSelector:
         ``stamp`` (s): where the person is now is then a guess."""
         return stamp - last_update >= self.coast_s
 
-    def lost(self, stamp: float) -> None:
-        """The target's track broke off (or was found on someone else) at ``stamp`` (s)."""
+    def lost(self, stamp: float, why: str = "") -> None:
+        """The target's track broke off (or was found on someone else) at ``stamp`` (s);
+        ``why`` says how, in the event's text."""
         if self.lost_since is None:
             self.lost_since = stamp
-            self.events.append(f"lost {self.target}")
+            self.events.append(f"lost {self.target}" + (f" ({why})" if why else ""))
 
     def expected(self, stamp: float) -> tuple[np.ndarray, float] | None:
         """Where the person should be now in the sensor frame (m), and how far from it they may be (m)."""

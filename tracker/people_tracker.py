@@ -1101,8 +1101,10 @@ class PeopleTracker:
         if sel.target is not None:
             t = next((u for u in self._tracks if u.track_id == sel.target), None)
             q = here([t])[t.track_id] if t is not None else None
+            why = "track ended" if t is None else "track not reported"
             if t is not None and t.reported and not sel.within_reach(stamp, q):
                 t = self._retire(t)  # it is somewhere the person cannot be: on someone or something else
+                why = "out of reach"
             if t is not None and t.reported and t.updated_now and sel.slid(q):
                 # moved off where the person has been while another track is there: it slid onto a passer-by,
                 # unless that one has just come there from elsewhere (a passer-by where the person was)
@@ -1111,16 +1113,16 @@ class PeopleTracker:
                 if there is not None and not sel.came_from_elsewhere(
                         self._trails[next(u for u in now if u.track_id == there)][0][1]):
                     t = self._retire(t)
-                    sel.lost(stamp)
+                    sel.lost(stamp, "slid onto someone")
             if t is not None and t.reported and t.updated_now:
                 sel.seen(stamp, q, t.velocity)
             elif t is None or not t.reported:
-                sel.lost(stamp)
+                sel.lost(stamp, why)
             elif sel.coasting(stamp, t.last_update):
                 # coasting, while a track is updated where the person should be: that one is them
                 if sel.only_one_near(stamp, here(u for u in self._tracks if u is not t and u.updated_now)) is not None:
                     t = self._retire(t)
-                    sel.lost(stamp)
+                    sel.lost(stamp, "coasting, another track where they should be")
             if sel.lost_since is not None:
                 others = [u for u in self._tracks if u.track_id != sel.target and u.reported and u not in unreported]
                 new_id = sel.reacquire(stamp, here(others), {u.track_id: u.velocity for u in others})

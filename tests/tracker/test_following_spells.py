@@ -11,7 +11,8 @@ from following_losses import _wrong_spells  # noqa: E402
 def _marks(spec):
     """Scans 0.1 s apart from (track, on whom, person visible) per scan (None: no target);
     the person is person 1."""
-    return [None if s is None else (0.1 * n, s[1] == 1, s[0], s[1], s[2]) for n, s in enumerate(spec)]
+    return [None if s is None else (0.1 * n, s[1] == 1, s[0], s[1], s[2], "lost 1 (track ended)")
+            for n, s in enumerate(spec)]
 
 
 def test_a_track_that_goes_from_the_person_onto_someone_and_an_id_given_to_another():
@@ -24,7 +25,7 @@ def test_a_track_that_goes_from_the_person_onto_someone_and_an_id_given_to_anoth
     assert len(lines) == 2
     assert "12 scans  on person 5 (12); the track last on the person, 0.10 s before" in lines[0]
     assert lines[0].strip().startswith("0.10 s")
-    assert "11 scans  on someone or something else (11); another track (the person's id given to it)" in lines[1]
+    assert "11 scans  on someone or something else (11); another track (the person's id given to it after 'lost 1 (track ended)')" in lines[1]
 
 
 def test_a_target_on_nothing_while_the_person_is_hidden_is_no_spell():

@@ -803,3 +803,4 @@ def test_a_target_back_from_coasting_on_a_passer_by_does_not_drag_the_persons_pl
             break
     assert new is not None and person.track_id != pid  # the track on the passer-by goes on under a new id
     assert sel.lost_since is not None  # and the re-lock looks for the person
+    assert sel.events[-1] == f"lost {pid} (slid onto someone)"
