@@ -153,6 +153,8 @@ class TargetSelector:
         else:
             self.steady, self._slid_since = q.copy(), None
         self._q, self._t, self._yaw = q.copy(), stamp, self.yaw
+        if self.lost_since is not None:  # their own track is back (a re-lock has said so already)
+            self.events.append(f"found {self.target} again")
         self.lost_since = None
 
     def moved(self, stamp: float, x: float, y: float) -> None:

@@ -804,3 +804,13 @@ def test_a_target_back_from_coasting_on_a_passer_by_does_not_drag_the_persons_pl
     assert new is not None and person.track_id != pid  # the track on the passer-by goes on under a new id
     assert sel.lost_since is not None  # and the re-lock looks for the person
     assert sel.events[-1] == f"lost {pid} (slid onto someone)"
+
+
+def test_the_events_say_how_the_target_was_lost_and_that_their_own_track_came_back():
+    sel = TargetSelector("auto")
+    assert sel.choose({4: np.array([2.0, 0.0])}, 0.0) == 4
+    sel.seen(0.0, np.array([2.0, 0.0]))
+    sel.lost(0.5, "track not reported")
+    sel.lost(0.6, "out of reach")  # already lost: no second event
+    sel.seen(0.7, np.array([2.0, 0.1]))  # their own track is reported again
+    assert sel.events == ["target 4", "lost 4 (track not reported)", "found 4 again"]
