@@ -46,8 +46,9 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
     person, sel = source.sim.target_id, tracker.selector
     out: Counter = Counter()
     locked, first = False, None  # first: the first scan's stamp (s)
-    marks = []  # per scan: None without a target, else (stamp s, on the person, its track, on whom, person visible,
+    # per scan: None without a target, else (stamp s, on the person, its track, on whom, person visible,
     # the selector's last 'lost' event)
+    marks = []
     for record in source.scans():
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
         truth = source.truths[record.index]
@@ -128,7 +129,8 @@ def _wrong_spells(marks: list, min_s: float, t0: float) -> list[str]:
 
 
 def one_run_arguments(doc: str, scene: str, seed: int, argv=None, spells: bool = False) -> argparse.Namespace:
-    """``--scene``, ``--laser``, ``--seed`` and ``--duration`` of one simulated following run."""
+    """``--scene``, ``--laser``, ``--seed`` and ``--duration`` of one simulated following run
+    (with ``spells``, also ``--spells``)."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--scene", default=scene)
     ap.add_argument("--laser", default="wide")
