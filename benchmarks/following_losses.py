@@ -18,6 +18,12 @@ second or more with the target on someone or something else while the person is 
 or the target is on someone: when, how long, on whom, and whether the target's track was the
 one last on the person (it went from them onto someone) or another (the id was given to it,
 after the loss the selector's event names).
+With ``--hops``, also each scan where the target's track, within
+``tracks.min_person_separation_m`` of the person the scan before, took a moving candidate
+made mostly of someone else's readings (the simulator says whose each reading is): the
+candidate's kind, whose readings, whether the person had a candidate of their own that scan
+(and who took it), and whether they stood still; then the counts. Candidates made of no
+moving object (``receding``) are not judged.
 The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
 """
 
@@ -26,6 +32,7 @@ from __future__ import annotations
 import argparse
 import sys
 from collections import Counter
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,13 +41,15 @@ from people_tracker.tracker.io.simulated import SimulatedSource
 from people_tracker.tracker.people_tracker import PeopleTracker, tracks_in_sensor_frame
 
 NEAR_M = 0.75  # m: the following protocol's match distance
+STILL_MPS = 0.1  # m/s: the person stands still when their torso moves slower than this (simulator's truth)
 
 
 def classify(scene: str, laser: str, seed: int, duration: float | None,
-             spells: list[str] | None = None, min_spell_s: float = 1.0) -> Counter:
+             spells: list[str] | None = None, min_spell_s: float = 1.0, hops: list | None = None) -> Counter:
     """The count of the person's visible scans after the first lock in each class; with a
     ``spells`` list, one line is added to it per spell of ``min_spell_s`` or more with the
-    target on someone or something else (see the module's text)."""
+    target on someone or something else; with a ``hops`` list, one :class:`Hop` per scan
+    where the target's track took someone else's candidate (see the module's text)."""
     source = SimulatedSource(scene, seed=seed, duration=duration, laser=laser)
     tracker = PeopleTracker.from_config(load_config(), follow="auto")
     person, sel = source.sim.target_id, tracker.selector
@@ -49,6 +58,7 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
     # per scan: None without a target, else (stamp s, on the person, its track, on whom, person visible,
     # the selector's last 'lost' event)
     marks = []
+    on_before, previous = None, None  # the target's id if on the person the scan before; that scan's truth
     for record in source.scans():
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
         truth = source.truths[record.index]
@@ -57,6 +67,13 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
         first = record.scan.stamp if first is None else first
         if spells is not None:
             marks.append(_mark(record.scan.stamp, tracks, tracker, truth, person, bool(len(k))))
+        if hops is not None:
+            if on_before is not None and len(k):
+                hop = _hop(tracker, truth, previous, person, on_before, record.scan.stamp - first)
+                if hop is not None:
+                    hops.append(hop)
+            on_before = _target_on(tracks, tracker, truth, person, tracker.track_params.min_person_separation_m)
+            previous = truth
         if not len(k) or not locked:
             continue
         here = dict(zip((t.track_id for t in tracks), tracks_in_sensor_frame(tracks, tracker.last.pose)))
@@ -88,6 +105,83 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
     if spells is not None:
         spells += _wrong_spells(marks, min_spell_s, first or 0.0)
     return out
+
+
+@dataclass(frozen=True)
+class Hop:
+    """One scan where the target's track, on the person the scan before, took a candidate
+    made mostly of someone else's readings."""
+
+    t_s: float  # from the first scan, s
+    kind: str  # the candidate's kind (pair, leg, blob)
+    whose: dict  # person id (-1: no one, the surroundings) -> how many of its readings
+    own: tuple  # the person's own candidates this scan: "kind->who took it" (C confirmed, t tentative, none)
+    still: bool  # the person stood still (slower than STILL_MPS)
+
+    def line(self) -> str:
+        whose = ", ".join(f"{'surroundings' if p < 0 else f'person {p}'} ({n})" for p, n in
+                          sorted(self.whose.items(), key=lambda kv: -kv[1]))
+        own = ", ".join(self.own) if self.own else "none"
+        return (f"  {self.t_s:7.2f} s  {self.kind:5s} readings of {whose}; the person's own candidates: {own}; "
+                f"they {'stood still' if self.still else 'walked'}")
+
+
+def hop_counts(hops: list[Hop]) -> list[str]:
+    """The summary lines of ``--hops``."""
+    n = len(hops)
+    kinds = Counter(h.kind for h in hops)
+    return [f"scans where the target's track, on the person the scan before, took someone else's candidate: {n}",
+            f"  the person had no candidate of their own: {sum(not h.own for h in hops)}; "
+            f"they stood still: {sum(h.still for h in hops)}; both: {sum(h.still and not h.own for h in hops)}",
+            "  by the candidate's kind: " + (", ".join(f"{k} {c}" for k, c in kinds.most_common()) or "none")]
+
+
+def _target_on(tracks, tracker: PeopleTracker, truth, person: int, within_m: float) -> int | None:
+    """The target's id when it lies within ``within_m`` (m) of the visible person, else None."""
+    target = next((t for t in tracks if t.target), None)
+    k = np.flatnonzero((truth.person_id == person) & truth.visible)
+    if target is None or not len(k):
+        return None
+    q = tracks_in_sensor_frame([target], tracker.last.pose)[0]
+    return target.track_id if float(np.hypot(*(q - truth.torso_sensor[k[0]]))) <= within_m else None
+
+
+def _whose(candidate, objects: dict, truth) -> Counter:
+    """Whose readings (simulator's person id, -1 for the surroundings) a candidate is made of."""
+    return Counter(int(truth.beam_person[b]) for oid in candidate.object_ids for b in objects[oid].beams)
+
+
+def _hop(tracker: PeopleTracker, truth, previous, person: int, target_id: int, t_s: float) -> Hop | None:
+    """This scan's :class:`Hop` of the track ``target_id``, or None (see :func:`classify`)."""
+    last = tracker.last
+    took = [ci for tid, ci in last.matched if tid == target_id]
+    if not took or not last.candidates[took[0]].object_ids:
+        return None
+    objects = {o.object_id: o for o in last.detection.objects}
+    whose = _whose(last.candidates[took[0]], objects, truth)
+    if not whose or whose.most_common(1)[0][0] == person:
+        return None
+    k = int(np.flatnonzero(truth.person_id == person)[0])
+    inv = last.pose.inverse()
+    taker = dict((ci, tid) for tid, ci in last.matched)
+    confirmed = {t.track_id: t.confirmed for t in tracker._tracks}
+    own = []
+    for j, c in enumerate(last.candidates):
+        if j == took[0]:
+            continue
+        if c.object_ids:
+            w = _whose(c, objects, truth)
+            mine = bool(w) and w.most_common(1)[0][0] == person
+        else:  # no readings of its own to judge: theirs when it lies on them
+            q = inv.transform_points(np.array([[c.x, c.y]]))[0]
+            mine = float(np.hypot(*(q - truth.torso_sensor[k]))) <= tracker.track_params.min_person_separation_m
+        if mine:
+            tid = taker.get(j)
+            own.append(f"{c.kind}->{'none' if tid is None else ('C' if confirmed.get(tid, True) else 't')}")
+    kp = np.flatnonzero(previous.person_id == person)
+    dt = truth.stamp - previous.stamp
+    still = bool(len(kp)) and dt > 0 and float(np.hypot(*(truth.torso_world[k] - previous.torso_world[kp[0]]))) < STILL_MPS * dt
+    return Hop(t_s, last.candidates[took[0]].kind, dict(whose), tuple(own), still)
 
 
 def _mark(stamp: float, tracks, tracker: PeopleTracker, truth, person: int, visible: bool):
@@ -130,7 +224,7 @@ def _wrong_spells(marks: list, min_s: float, t0: float) -> list[str]:
 
 def one_run_arguments(doc: str, scene: str, seed: int, argv=None, spells: bool = False) -> argparse.Namespace:
     """``--scene``, ``--laser``, ``--seed`` and ``--duration`` of one simulated following run
-    (with ``spells``, also ``--spells``)."""
+    (with ``spells``, also ``--spells`` and ``--hops``)."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--scene", default=scene)
     ap.add_argument("--laser", default="wide")
@@ -139,13 +233,17 @@ def one_run_arguments(doc: str, scene: str, seed: int, argv=None, spells: bool =
     if spells:
         ap.add_argument("--spells", action="store_true",
                         help="also list each spell of a second or more with the target on someone or something else")
+        ap.add_argument("--hops", action="store_true",
+                        help="also list each scan where the target's track went from the person onto someone "
+                             "else's candidate, and count them")
     return ap.parse_args(argv)
 
 
 def main(argv=None) -> int:
     args = one_run_arguments(__doc__, "follow_indoor_crowd", 2, argv, spells=True)
     spells: list[str] | None = [] if args.spells else None
-    counts = classify(args.scene, args.laser, args.seed, args.duration, spells)
+    hops: list[Hop] | None = [] if args.hops else None
+    counts = classify(args.scene, args.laser, args.seed, args.duration, spells, hops=hops)
     total = sum(counts.values())
     print(f"{args.scene}, laser {args.laser}, seed {args.seed}: {total} scans with the person visible after the first lock")
     for what, n in sorted(counts.items(), key=lambda kv: -kv[1]):
@@ -153,6 +251,11 @@ def main(argv=None) -> int:
     if spells is not None:
         print("spells of 1 s or more with the target on someone or something else (s from the first scan):")
         print("\n".join(spells) if spells else "  none")
+    if hops is not None:
+        print("scans where the target's track went from the person onto someone else's candidate "
+              "(s from the first scan):")
+        print("\n".join(h.line() for h in hops) if hops else "  none")
+        print("\n".join(hop_counts(hops)))
     return 0
 
 

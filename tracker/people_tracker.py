@@ -116,6 +116,7 @@ class StepResult:
     standing: list[PersonCandidate] = ()  # leg pairs found by shape (world frame)
     legs: LegCandidates | None = None  # every leg candidate of the scan (sensor frame) ...
     leg_scores: np.ndarray | None = None  # ... and the leg model's probability for each
+    matched: tuple[tuple[int, int], ...] = ()  # (track id when it took it, index into candidates): moving candidates taken this scan
 
 
 @dataclass(eq=False)
@@ -257,6 +258,7 @@ class PeopleTracker:
         candidates += self._receding(detection, scan, world)  # 3b. walkers in their own shadow
         matched = self._associate(candidates)  # 4. associate candidates to tracks
         matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
+        took = tuple((self._tracks[ti].track_id, ci) for ti, ci in matched)
         for ti, ci in matched:  # 5. update the matched tracks
             c = candidates[ci]
             self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
@@ -279,7 +281,7 @@ class PeopleTracker:
         first = self._first_steps(scan.stamp)  # not reported yet
         target = self._follow(world, scan.stamp, first)  # 10. the followed person
         reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.reported and t not in first]
-        self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing, legs, leg_scores)
+        self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing, legs, leg_scores, took)
         return reported
 
     @staticmethod

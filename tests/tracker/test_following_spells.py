@@ -32,3 +32,27 @@ def test_a_target_on_nothing_while_the_person_is_hidden_is_no_spell():
     a = object()
     spec = [(a, 1, True)] + [(a, None, False)] * 20  # coasting on through the gap: a guess, not wrong
     assert _wrong_spells(_marks(spec), 1.0, 0.0) == []
+
+
+def test_the_hops_are_counted_by_what_the_person_had_and_did():
+    from following_losses import Hop, hop_counts
+    hops = [Hop(1.0, "leg", {5: 8}, (), True), Hop(2.0, "pair", {6: 10, -1: 2}, ("pair->C",), False),
+            Hop(3.0, "leg", {7: 9}, (), False)]
+    lines = hop_counts(hops)
+    assert lines[0].endswith(": 3")
+    assert "no candidate of their own: 2; they stood still: 1; both: 1" in lines[1]
+    assert lines[2].endswith("leg 2, pair 1")
+    assert "pair  readings of person 6 (10), surroundings (2); the person's own candidates: pair->C; they walked" \
+        in hops[1].line()
+
+
+def test_a_simulated_run_lists_the_scans_where_the_persons_track_took_someone_elses_candidate():
+    """60 s of a development run: the followed person's track takes passers-by's legs."""
+    from following_losses import classify
+    hops = []
+    classify("follow_indoor_crowd", "narrow", 1, 60.0, hops=hops)
+    assert hops, "the person's track never took someone else's candidate"
+    for h in hops:
+        assert 0.0 < h.t_s <= 60.0
+        assert h.kind in ("leg", "pair", "blob")
+        assert max(h.whose, key=h.whose.get) != 1  # the followed person is the simulator's person 1
