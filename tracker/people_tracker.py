@@ -641,27 +641,7 @@ class PeopleTracker:
         doubt = np.array([0.0 if t.confirmed else -2.0 * math.log(max(t.existence.probability, 1e-9))
                           for t in self._tracks])
         cost = np.where(cost <= self.assoc.gate_chi2, cost + doubt[:, None], np.inf)
-        pairs = associate(cost, float(np.max(doubt, initial=0.0)) + self.assoc.gate_chi2, self.assoc.method)
-        return self._not_for_the_target(pairs, means, z)
-
-    def _not_for_the_target(self, pairs: list[tuple[int, int]], means: np.ndarray, z: np.ndarray) -> list[tuple[int, int]]:
-        """``pairs`` (track, candidate) without the followed person's when their candidate
-        lies nearer the prediction of another confirmed track that took a candidate this scan
-        than their own (``means``, ``z``: predictions and candidates, world frame, m): most
-        likely somebody else's leg, the person's own legs unseen or not moving (walking on in
-        their own shadow, or stopping). Their track coasts a scan rather than follow somebody
-        else; other tracks keep the assignment (in a crowd, a track that skips a scan loses
-        more than it gains)."""
-        target = self.selector.target if self.selector is not None else None
-        ti = next((i for i, t in enumerate(self._tracks) if t.track_id == target), None)
-        mine = [ci for i, ci in pairs if i == ti]
-        others = [i for i, _ in pairs if i != ti and self._tracks[i].confirmed]
-        if not mine or not others:
-            return pairs
-        c = z[mine[0]]
-        if pairwise_distances(means[others], c[None]).min() < float(np.hypot(*(means[ti] - c))):
-            return [(i, ci) for i, ci in pairs if i != ti]
-        return pairs
+        return associate(cost, float(np.max(doubt, initial=0.0)) + self.assoc.gate_chi2, self.assoc.method)
 
     def _recover(self, candidates: list[PersonCandidate], matched: list[tuple[int, int]]) -> list[tuple[int, int]]:
         """Leftover candidates for confirmed tracks the gate left alone: first tracks that lost

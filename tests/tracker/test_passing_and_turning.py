@@ -814,21 +814,3 @@ def test_the_events_say_how_the_target_was_lost_and_that_their_own_track_came_ba
     sel.lost(0.6, "out of reach")  # already lost: no second event
     sel.seen(0.7, np.array([2.0, 0.1]))  # their own track is reported again
     assert sel.events == ["target 4", "lost 4 (track not reported)", "found 4 again"]
-
-
-def test_the_followed_persons_track_coasts_rather_than_take_a_leg_nearer_someone_else():
-    """Traced on development runs (docs/following.md, fifty-first session): the person's own
-    legs give no moving candidate (they walk on in their own shadow, or stop) while a
-    passer-by's two legs give two; the passer-by's track takes one, and the person's track
-    the other, and goes off with them. The followed person's track coasts instead."""
-    own_pair = PersonCandidate(2.7, 0.35, 0.08, "pair")  # the passer-by's legs, on their track
-    second_leg = PersonCandidate(2.45, 0.2, 0.2, "leg")  # 0.18 m from the passer-by, 0.49 m from the person
-    for target, expected in ((None, [(0, 1), (1, 0)]), (0, [(1, 0)]), (1, [(0, 1), (1, 0)])):
-        tracker = _two_tracks(other_at=(2.6, 0.3))
-        if target is not None:
-            tracker.selector = TargetSelector(tracker._tracks[target].track_id)
-        assert sorted(tracker._associate([own_pair, second_leg])) == expected, target
-    # a leg nearer the person than anyone else stays theirs
-    tracker = _two_tracks(other_at=(2.6, 0.3))
-    tracker.selector = TargetSelector(tracker._tracks[0].track_id)
-    assert sorted(tracker._associate([own_pair, PersonCandidate(2.2, 0.1, 0.2, "leg")])) == [(0, 1), (1, 0)]
