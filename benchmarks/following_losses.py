@@ -65,20 +65,22 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
         k = np.flatnonzero((truth.person_id == person) & truth.visible)
         locked |= any(t.target for t in tracks)
         first = record.scan.stamp if first is None else first
+        # the reported tracks' places in the sensor frame (m), and the target's id (None without one)
+        here = dict(zip((t.track_id for t in tracks), tracks_in_sensor_frame(tracks, tracker.last.pose)))
+        target = next((t.track_id for t in tracks if t.target), None)
         if spells is not None:
-            marks.append(_mark(record.scan.stamp, tracks, tracker, truth, person, bool(len(k))))
+            marks.append(_mark(record.scan.stamp, target, here, tracker, truth, person, bool(len(k))))
         if hops is not None:
             if on_before is not None and len(k):
-                hop = _hop(tracker, truth, previous, person, on_before, record.scan.stamp - first)
+                hop = _hop(tracker, truth, previous, person, int(k[0]), on_before, record.scan.stamp - first)
                 if hop is not None:
                     hops.append(hop)
-            on_before = _target_on(tracks, tracker, truth, person, tracker.track_params.min_person_separation_m)
-            previous = truth
+            near = bool(len(k)) and target is not None and \
+                float(np.hypot(*(here[target] - truth.torso_sensor[k[0]]))) <= tracker.track_params.min_person_separation_m
+            on_before, previous = (target if near else None), truth
         if not len(k) or not locked:
             continue
-        here = dict(zip((t.track_id for t in tracks), tracks_in_sensor_frame(tracks, tracker.last.pose)))
         dist = {tid: float(np.hypot(*(q - truth.torso_sensor[k[0]]))) for tid, q in here.items()}
-        target = next((t.track_id for t in tracks if t.target), None)
         if target is not None:
             out["target on the person" if dist[target] <= NEAR_M else "target on someone or something else"] += 1
             continue
@@ -136,23 +138,14 @@ def hop_counts(hops: list[Hop]) -> list[str]:
             "  by the candidate's kind: " + (", ".join(f"{k} {c}" for k, c in kinds.most_common()) or "none")]
 
 
-def _target_on(tracks, tracker: PeopleTracker, truth, person: int, within_m: float) -> int | None:
-    """The target's id when it lies within ``within_m`` (m) of the visible person, else None."""
-    target = next((t for t in tracks if t.target), None)
-    k = np.flatnonzero((truth.person_id == person) & truth.visible)
-    if target is None or not len(k):
-        return None
-    q = tracks_in_sensor_frame([target], tracker.last.pose)[0]
-    return target.track_id if float(np.hypot(*(q - truth.torso_sensor[k[0]]))) <= within_m else None
-
-
 def _whose(candidate, objects: dict, truth) -> Counter:
     """Whose readings (simulator's person id, -1 for the surroundings) a candidate is made of."""
     return Counter(int(truth.beam_person[b]) for oid in candidate.object_ids for b in objects[oid].beams)
 
 
-def _hop(tracker: PeopleTracker, truth, previous, person: int, target_id: int, t_s: float) -> Hop | None:
-    """This scan's :class:`Hop` of the track ``target_id``, or None (see :func:`classify`)."""
+def _hop(tracker: PeopleTracker, truth, previous, person: int, k: int, target_id: int, t_s: float) -> Hop | None:
+    """This scan's :class:`Hop` of the track ``target_id``, or None (see :func:`classify`);
+    ``k``: the person's index in ``truth``."""
     last = tracker.last
     took = [ci for tid, ci in last.matched if tid == target_id]
     if not took or not last.candidates[took[0]].object_ids:
@@ -161,7 +154,6 @@ def _hop(tracker: PeopleTracker, truth, previous, person: int, target_id: int, t
     whose = _whose(last.candidates[took[0]], objects, truth)
     if not whose or whose.most_common(1)[0][0] == person:
         return None
-    k = int(np.flatnonzero(truth.person_id == person)[0])
     inv = last.pose.inverse()
     taker = dict((ci, tid) for tid, ci in last.matched)
     confirmed = {t.track_id: t.confirmed for t in tracker._tracks}
@@ -184,16 +176,15 @@ def _hop(tracker: PeopleTracker, truth, previous, person: int, target_id: int, t
     return Hop(t_s, last.candidates[took[0]].kind, dict(whose), tuple(own), still)
 
 
-def _mark(stamp: float, tracks, tracker: PeopleTracker, truth, person: int, visible: bool):
-    """One scan's target for :func:`_wrong_spells`, or None without a target."""
-    target = next((t for t in tracks if t.target), None)
+def _mark(stamp: float, target: int | None, here: dict, tracker: PeopleTracker, truth, person: int, visible: bool):
+    """One scan's target for :func:`_wrong_spells`, or None without a target (``here``: the
+    reported tracks' places in the sensor frame, m)."""
     if target is None:
         return None
-    q = tracks_in_sensor_frame([target], tracker.last.pose)[0]
-    d = np.hypot(*(truth.torso_sensor - q).T)
+    d = np.hypot(*(truth.torso_sensor - here[target]).T)
     j = int(np.argmin(d)) if len(d) else -1
     whom = int(truth.person_id[j]) if j >= 0 and d[j] <= NEAR_M else None
-    state = next(u for u in tracker._tracks if u.track_id == target.track_id)
+    state = next(u for u in tracker._tracks if u.track_id == target)
     lost = next((e for e in reversed(tracker.selector.events) if e.startswith("lost")), None)
     return stamp, whom == person, state, whom, visible, lost
 
@@ -222,15 +213,15 @@ def _wrong_spells(marks: list, min_s: float, t0: float) -> list[str]:
     return lines
 
 
-def one_run_arguments(doc: str, scene: str, seed: int, argv=None, spells: bool = False) -> argparse.Namespace:
+def one_run_arguments(doc: str, scene: str, seed: int, argv=None, listings: bool = False) -> argparse.Namespace:
     """``--scene``, ``--laser``, ``--seed`` and ``--duration`` of one simulated following run
-    (with ``spells``, also ``--spells`` and ``--hops``)."""
+    (with ``listings``, also ``--spells`` and ``--hops``)."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--scene", default=scene)
     ap.add_argument("--laser", default="wide")
     ap.add_argument("--seed", type=int, default=seed)
     ap.add_argument("--duration", type=float, help="seconds (default: the scene's 10 minutes)")
-    if spells:
+    if listings:
         ap.add_argument("--spells", action="store_true",
                         help="also list each spell of a second or more with the target on someone or something else")
         ap.add_argument("--hops", action="store_true",
@@ -240,7 +231,7 @@ def one_run_arguments(doc: str, scene: str, seed: int, argv=None, spells: bool =
 
 
 def main(argv=None) -> int:
-    args = one_run_arguments(__doc__, "follow_indoor_crowd", 2, argv, spells=True)
+    args = one_run_arguments(__doc__, "follow_indoor_crowd", 2, argv, listings=True)
     spells: list[str] | None = [] if args.spells else None
     hops: list[Hop] | None = [] if args.hops else None
     counts = classify(args.scene, args.laser, args.seed, args.duration, spells, hops=hops)
