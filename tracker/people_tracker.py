@@ -274,7 +274,7 @@ class PeopleTracker:
         self.places.add(scan, world)
         self._remember_standing(scan, world)
         self._reacquire_standing(scan, world)
-        self._initiate(candidates, {ci for _, ci in matched}, scan.stamp)  # 8. new tentative tracks
+        self._initiate(candidates, {ci for _, ci in matched}, scan.stamp, world)  # 8. new tentative tracks
         self._initiate_standing(standing, scan.stamp)  # 8b. and standing people who persist
         self._initiate_arrivals(arrivals, world, scan.stamp)  # 8c. and who arrived, legs merged or hidden
         self._delete(scan.stamp)  # 9. delete what the lifecycle rules end
@@ -930,17 +930,28 @@ class PeopleTracker:
             self._tracks[-1].place = place
             self._next_id += 1
 
-    def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float) -> None:
+    def _initiate(self, candidates: list[PersonCandidate], used: set[int], stamp: float, world: Pose2D) -> None:
         used = used | {ci for ci, c in enumerate(candidates) if c.kind == "receding"}
         fresh = [ci for ci in range(len(candidates)) if ci not in used]
         free = np.ones(len(candidates), dtype=bool)
         if fresh and self.assoc.free_space_lookback_s > 0:
             xy = np.array([(candidates[ci].x, candidates[ci].y) for ci in fresh])
             # a leg-shaped candidate needs no empty place: someone walking away in their own
-            # shadow, with nothing behind them to see past, was never seen arriving
-            free[fresh] = self._seen_empty(xy, stamp) | (np.nan_to_num(self._best_leg(xy)) >=
-                                                         self.assoc.start_leg_probability)
+            # shadow, with nothing behind them to see past, was never seen arriving; nor does
+            # one far ahead where the followed person, lost, may be: back in view round a
+            # corner, walking away, too far for their legs to look like legs
+            free[fresh] = (self._seen_empty(xy, stamp)
+                           | (np.nan_to_num(self._best_leg(xy)) >= self.assoc.start_leg_probability)
+                           | self._lost_person_far_ahead(xy, stamp, world))
         self._spawn([c for ci, c in enumerate(candidates) if ci not in used and free[ci]], stamp)
+
+    def _lost_person_far_ahead(self, xy: np.ndarray, stamp: float, world: Pose2D) -> np.ndarray:
+        """Whether each place (world frame, m) is where the followed person, lost, may be back
+        in view far ahead (:meth:`TargetSelector.back_far_ahead`)."""
+        sel = self.selector
+        if sel is None or sel.lost_since is None:
+            return np.zeros(len(xy), dtype=bool)
+        return np.array([sel.back_far_ahead(stamp, q) for q in world.inverse().transform_points(xy)], dtype=bool)
 
     def _duplicates(self, stamp: float) -> set[int]:
         """Indices of tracks that are a person who has a track already: slid onto someone

@@ -814,3 +814,31 @@ def test_the_events_say_how_the_target_was_lost_and_that_their_own_track_came_ba
     sel.lost(0.6, "out of reach")  # already lost: no second event
     sel.seen(0.7, np.array([2.0, 0.1]))  # their own track is reported again
     assert sel.events == ["target 4", "lost 4 (track not reported)", "found 4 again"]
+
+
+def test_the_followed_person_back_in_view_far_ahead_starts_a_track_where_they_are_looked_for():
+    """Traced on `follow_outdoor` and `follow_indoor_crowd` (development seed 1, every laser):
+    the robot held still at a corner while the person walked round it; when it drove on they
+    came back into view 5-6 m away, walking away from it. Their legs, four to ten readings
+    each at that range, scored 0.0-0.3 as legs, and the place where they walked had never
+    been seen empty (it was round the corner), so no track started on their moving legs for
+    3-4 s. A moving candidate farther than the lock range, within reach of where the lost
+    person should be, starts a track without either test; nearer, where legs are seen well
+    enough to score, and with nobody lost, the tests stand."""
+    tracker = PeopleTracker.from_config(load_config(), follow="auto")
+    tracker._legs_world, tracker._leg_scores = np.zeros((0, 2)), np.zeros(0)  # nothing leg-shaped
+    far, near = PersonCandidate(5.0, 0.3, 0.1, "leg"), PersonCandidate(3.0, 0.3, 0.1, "leg")
+    sel = tracker.selector
+
+    def started(candidate, lost: bool) -> bool:
+        tracker._tracks = []
+        sel.target, sel.lost_since = 1, (9.0 if lost else None)
+        sel.seen(8.0, np.array([4.0, 0.0]))  # last seen 4 m ahead, 2 s ago
+        sel.lost_since = 9.0 if lost else None
+        tracker._initiate([candidate], set(), 10.0, Pose2D())
+        return len(tracker._tracks) == 1
+
+    assert started(far, lost=True)
+    assert not started(far, lost=False)
+    assert not started(near, lost=True)  # within the lock range (3.5 m): the usual tests
+    assert not started(PersonCandidate(5.0, -5.0, 0.1, "leg"), lost=True)  # not where they could be
