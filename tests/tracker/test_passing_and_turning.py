@@ -832,7 +832,7 @@ def test_the_followed_person_back_in_view_far_ahead_starts_a_track_where_they_ar
 
     def started(candidate, lost: bool) -> bool:
         tracker._tracks = []
-        sel.target, sel.lost_since = 1, (9.0 if lost else None)
+        sel.target = 1
         sel.seen(8.0, np.array([4.0, 0.0]))  # last seen 4 m ahead, 2 s ago
         sel.lost_since = 9.0 if lost else None
         tracker._initiate([candidate], set(), 10.0, Pose2D())
