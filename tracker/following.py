@@ -222,14 +222,17 @@ class TargetSelector:
         exp = self.expected(stamp)
         return exp is None or float(np.hypot(*(np.asarray(q) - exp[0]))) <= exp[1]
 
+    @property
+    def looking(self) -> bool:
+        """Whether ``auto`` is looking for its lost person now."""
+        return self.mode == "auto" and self.target is not None and self.lost_since is not None
+
     def back_far_ahead(self, stamp: float, q: np.ndarray) -> bool:
         """Whether the lost person could be at ``q`` (sensor frame, m) now, beyond the lock zone's
         range (``lock_range_m``): where their legs, a few readings each, are too sparse to look
-        like legs, and ``auto`` looks for them. False while the person is not lost (or, without
-        ``auto``, ever)."""
-        if self.mode != "auto" or self.target is None or self.lost_since is None:
-            return False
-        return math.hypot(float(q[0]), float(q[1])) > self._lock_range and self.within_reach(stamp, q)
+        like legs, and ``auto`` looks for them (:attr:`looking`; else False)."""
+        return (self.looking and math.hypot(float(q[0]), float(q[1])) > self._lock_range
+                and self.within_reach(stamp, q))
 
     def only_one_near(self, stamp: float, others: dict[int, np.ndarray], steady: bool = False) -> int | None:
         """The one track (id → sensor-frame place) where the person should be (or, with

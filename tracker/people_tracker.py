@@ -949,7 +949,7 @@ class PeopleTracker:
         """Whether each place (world frame, m) is where the followed person, lost, may be back
         in view far ahead (:meth:`TargetSelector.back_far_ahead`)."""
         sel = self.selector
-        if sel is None or sel.lost_since is None:
+        if sel is None or not sel.looking:  # nobody lost: no transform of the candidates
             return np.zeros(len(xy), dtype=bool)
         return np.array([sel.back_far_ahead(stamp, q) for q in world.inverse().transform_points(xy)], dtype=bool)
 
