@@ -184,6 +184,7 @@ class AssociationConfig:
     receding: bool = field(metadata=_spec())
     set_off_speed_mps: float = field(metadata=_spec(lo=0.0, hi=10.0))
     contested_set_off_probability: float = field(metadata=_spec(lo=0.0, hi=1.0))
+    stopping_speed_mps: float = field(metadata=_spec(lo=0.0, hi=10.0))
 
     def params(self):
         from people_tracker.tracker.people_tracker import AssociationParams

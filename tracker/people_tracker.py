@@ -85,6 +85,14 @@ class AssociationParams:
         than the walker's leg. The standing track pays ``-2 ln`` of it on top of its squared
         Mahalanobis distance (a walker passing close by someone standing must not carry
         their track off); 1 turns it off.
+    stopping_speed_mps : float
+        A confirmed walking track slower than this (m/s) that was this fast or faster within
+        the last ``tracks.still_after_s`` is slowing to a stop. While a person-sized group of
+        readings that belong to no moving object lies at its prediction (static support), it
+        takes no moving candidate lying more than ``tracks.min_person_separation_m`` farther
+        from its prediction than that group, and the re-join of sharp turns gives it none:
+        someone who stops has no moving legs, and a passer-by's leg beside them must not
+        carry their track off before it counts as standing still. 0 turns it off.
     """
 
     method: str = "gnn"
@@ -101,6 +109,7 @@ class AssociationParams:
     receding: bool = True
     set_off_speed_mps: float = 0.5
     contested_set_off_probability: float = 0.1
+    stopping_speed_mps: float = 0.6
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,6 +201,7 @@ class PeopleTracker:
         self._stood: list[StoodPlace] = []
         self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
         self._leg_scores = np.zeros(0)  # ... and their leg probabilities
+        self._stopping: dict[int, np.ndarray] = {}  # track index -> the candidates it may not take this scan
         self._explained: np.ndarray | None = None  # this scan's readings taken by moving candidates given to tracks
         self._segments: tuple = (None, None)  # (scan, its scan_segments) for static support's calls on it
         self._tracks: list[TrackState] = []
@@ -256,6 +266,7 @@ class PeopleTracker:
         self._leg_scores = leg_scores
         candidates = self._candidates(detection, world, legs, leg_scores)  # 3. legs paired into people (world frame)
         candidates += self._receding(detection, scan, world)  # 3b. walkers in their own shadow
+        self._stopping = self._stopping_at_own_readings(candidates, scan, world, self._object_readings(detection))
         matched = self._associate(candidates)  # 4. associate candidates to tracks
         matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
         took = tuple((self._tracks[ti].track_id, ci) for ti, ci in matched)
@@ -603,6 +614,37 @@ class PeopleTracker:
             out.append(PersonCandidate(float(z[0]), float(z[1]), self.pairing.sigma_single_leg_m, "receding"))
         return out
 
+    def _stopping_at_own_readings(self, candidates: list[PersonCandidate], scan: Scan, world: Pose2D,
+                                  moving: np.ndarray) -> dict[int, np.ndarray]:
+        """For each confirmed walker slowing to a stop (``association.stopping_speed_mps``) whose
+        prediction still holds a person-sized group of readings no moving object holds: which
+        candidates it may not take this scan (by index into ``candidates``, a mask), those
+        lying more than ``tracks.min_person_separation_m`` farther from its prediction than
+        that group (``moving``: per beam, the readings of every moving object). Also notes,
+        for every track, when it was last that fast."""
+        v_stop = self.assoc.stopping_speed_mps
+        if v_stop <= 0:
+            return {}
+        slowing = []
+        for i, t in enumerate(self._tracks):
+            if float(np.hypot(*t.velocity)) >= v_stop:
+                t.brisk_at = scan.stamp
+            elif t.confirmed and not t.still and scan.stamp - t.brisk_at <= self.track_params.still_after_s:
+                slowing.append(i)
+        if not slowing or not candidates:
+            return {}
+        places = np.array([self._tracks[i].position for i in slowing])
+        found = self._static_support(places, scan, world, moving)
+        z = np.array([(c.x, c.y) for c in candidates])
+        d = pairwise_distances(places, z)
+        out = {}
+        for k, (i, group) in enumerate(zip(slowing, found)):
+            if group is not None:
+                far = d[k] > float(np.hypot(*(group - places[k]))) + self.track_params.min_person_separation_m
+                if far.any():
+                    out[i] = far
+        return out
+
     def _associate(self, candidates: list[PersonCandidate]) -> list[tuple[int, int]]:
         if not self._tracks or not candidates:
             return []
@@ -611,6 +653,8 @@ class PeopleTracker:
         z = np.array([(c.x, c.y) for c in candidates])
         R = np.array([c.R for c in candidates])
         cost = mahalanobis_costs(means, covs, z, R)
+        for i, far in self._stopping.items():  # slowing to a stop: not a candidate beyond their own readings
+            cost[i, far] = np.inf
         # someone seen standing still sets off from where they stand, with a leg beside them:
         # anything moving farther away is somebody else passing by (or facing them). One
         # never seen moving (found standing) sets off from where they were found.
@@ -656,7 +700,7 @@ class PeopleTracker:
             return []
         taken_t, taken_c = {t for t, _ in matched}, {c for _, c in matched}
         ts = self._tracks
-        lost = self._lost_walkers(i for i in range(len(ts)) if i not in taken_t)
+        lost = self._lost_walkers(i for i in range(len(ts)) if i not in taken_t and i not in self._stopping)
         pairs = self._recover_to(candidates, lost, [ts[i].moving_position for i in lost], taken_c, r)
         taken_c |= {c for _, c in pairs}
         walkers = np.array([t.position for t in ts if t.confirmed and not t.still]).reshape(-1, 2)

@@ -113,6 +113,7 @@ class TrackState:
         self.born = stamp
         self.last_update = stamp
         self.last_moving_update = stamp
+        self.brisk_at = -math.inf  # when the tracker last saw it at association.stopping_speed_mps or faster, s
         self.velocity_since = stamp  # when its velocity was last forgotten (born, stood, turned), s
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
         self.seen_position = np.array([x, y])  # where the last update of any kind put it, m

@@ -842,3 +842,39 @@ def test_the_followed_person_back_in_view_far_ahead_starts_a_track_where_they_ar
     assert not started(far, lost=False)
     assert not started(near, lost=True)  # within the lock range (3.5 m): the usual tests
     assert not started(PersonCandidate(5.0, -5.0, 0.1, "leg"), lost=True)  # not where they could be
+
+
+def _slowing_walker(now: float, brisk_s_ago: float = 0.3):
+    """A tracker with one confirmed walker at (3, 0) (world frame = sensor frame, m) at ``now``
+    (s), slowing (0.3 m/s along x), last seen walking briskly ``brisk_s_ago`` s before, its
+    place uncertain to 0.3 m (a passer-by's leg 0.8 m off lies within its gate)."""
+    tracker = PeopleTracker.from_config(load_config())
+    tracker._spawn([PersonCandidate(3.0, 0.0, 0.05, "pair")], now - 0.1)
+    walker = tracker._tracks[0]
+    walker.confirmed = True
+    walker.kf.x[1] = 0.3
+    walker.kf.P = np.diag([0.3 ** 2, 0.5, 0.3 ** 2, 0.5])
+    walker.stamp = walker.last_update = walker.last_moving_update = now
+    walker.brisk_at = now - brisk_s_ago
+    return tracker, walker
+
+
+def test_someone_slowing_to_a_stop_keeps_their_track_from_a_passers_by_leg():
+    # the person stops at (3, 0): legs together, no moving candidate of their own; a
+    # passer-by's moving leg 0.8 m beside them
+    passer = [PersonCandidate(3.0, 0.8, 0.08, "leg")]
+    moving = lambda scan: np.zeros(scan.n_beams, dtype=bool)  # noqa: E731 (no moving object's readings)
+    nobody = _scan([])
+    tracker, _ = _slowing_walker(nobody.stamp)
+    tracker._stopping = tracker._stopping_at_own_readings(passer, nobody, Pose2D(), moving(nobody))
+    assert tracker._associate(passer) == [(0, 0)]  # nothing where they were: the leg may be theirs
+    person = _scan([[3.0, 0.08, 0.06], [3.0, -0.08, 0.06]])
+    tracker, _ = _slowing_walker(person.stamp)
+    tracker._stopping = tracker._stopping_at_own_readings(passer, person, Pose2D(), moving(person))
+    assert tracker._associate(passer) == [] and tracker._recover(passer, []) == []
+    near = [PersonCandidate(3.0, 0.25, 0.08, "leg")]  # within a person's width of their legs: may be theirs
+    tracker._stopping = tracker._stopping_at_own_readings(near, person, Pose2D(), moving(person))
+    assert tracker._associate(near) == [(0, 0)]
+    tracker, _ = _slowing_walker(person.stamp, brisk_s_ago=5.0)  # slow for long: not slowing to a stop
+    tracker._stopping = tracker._stopping_at_own_readings(passer, person, Pose2D(), moving(person))
+    assert tracker._associate(passer) == [(0, 0)]
