@@ -266,7 +266,7 @@ class PeopleTracker:
         self._leg_scores = leg_scores
         candidates = self._candidates(detection, world, legs, leg_scores)  # 3. legs paired into people (world frame)
         candidates += self._receding(detection, scan, world)  # 3b. walkers in their own shadow
-        self._stopping = self._stopping_at_own_readings(candidates, scan, world, self._object_readings(detection))
+        self._stopping = self._stopping_at_own_readings(candidates, detection, scan, world)
         matched = self._associate(candidates)  # 4. associate candidates to tracks
         matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
         took = tuple((self._tracks[ti].track_id, ci) for ti, ci in matched)
@@ -614,14 +614,13 @@ class PeopleTracker:
             out.append(PersonCandidate(float(z[0]), float(z[1]), self.pairing.sigma_single_leg_m, "receding"))
         return out
 
-    def _stopping_at_own_readings(self, candidates: list[PersonCandidate], scan: Scan, world: Pose2D,
-                                  moving: np.ndarray) -> dict[int, np.ndarray]:
+    def _stopping_at_own_readings(self, candidates: list[PersonCandidate], detection: Detection, scan: Scan,
+                                  world: Pose2D) -> dict[int, np.ndarray]:
         """For each confirmed walker slowing to a stop (``association.stopping_speed_mps``) whose
         prediction still holds a person-sized group of readings no moving object holds: which
         candidates it may not take this scan (by index into ``candidates``, a mask), those
         lying more than ``tracks.min_person_separation_m`` farther from its prediction than
-        that group (``moving``: per beam, the readings of every moving object). Also notes,
-        for every track, when it was last that fast."""
+        that group. Also notes, for every track, when it was last that fast."""
         v_stop = self.assoc.stopping_speed_mps
         if v_stop <= 0:
             return {}
@@ -634,7 +633,7 @@ class PeopleTracker:
         if not slowing or not candidates:
             return {}
         places = np.array([self._tracks[i].position for i in slowing])
-        found = self._static_support(places, scan, world, moving)
+        found = self._static_support(places, scan, world, self._object_readings(detection))
         z = np.array([(c.x, c.y) for c in candidates])
         d = pairwise_distances(places, z)
         out = {}

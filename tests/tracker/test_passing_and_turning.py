@@ -860,21 +860,25 @@ def _slowing_walker(now: float, brisk_s_ago: float = 0.3):
 
 
 def test_someone_slowing_to_a_stop_keeps_their_track_from_a_passers_by_leg():
+    from people_tracker.detection.detector import Detection
+
+    def nothing_moving(scan):  # the detector found no moving object
+        return Detection(np.zeros(scan.n_beams, dtype=np.int8), [], ())
+
     # the person stops at (3, 0): legs together, no moving candidate of their own; a
     # passer-by's moving leg 0.8 m beside them
     passer = [PersonCandidate(3.0, 0.8, 0.08, "leg")]
-    moving = lambda scan: np.zeros(scan.n_beams, dtype=bool)  # noqa: E731 (no moving object's readings)
     nobody = _scan([])
     tracker, _ = _slowing_walker(nobody.stamp)
-    tracker._stopping = tracker._stopping_at_own_readings(passer, nobody, Pose2D(), moving(nobody))
+    tracker._stopping = tracker._stopping_at_own_readings(passer, nothing_moving(nobody), nobody, Pose2D())
     assert tracker._associate(passer) == [(0, 0)]  # nothing where they were: the leg may be theirs
     person = _scan([[3.0, 0.08, 0.06], [3.0, -0.08, 0.06]])
     tracker, _ = _slowing_walker(person.stamp)
-    tracker._stopping = tracker._stopping_at_own_readings(passer, person, Pose2D(), moving(person))
+    tracker._stopping = tracker._stopping_at_own_readings(passer, nothing_moving(person), person, Pose2D())
     assert tracker._associate(passer) == [] and tracker._recover(passer, []) == []
     near = [PersonCandidate(3.0, 0.25, 0.08, "leg")]  # within a person's width of their legs: may be theirs
-    tracker._stopping = tracker._stopping_at_own_readings(near, person, Pose2D(), moving(person))
+    tracker._stopping = tracker._stopping_at_own_readings(near, nothing_moving(person), person, Pose2D())
     assert tracker._associate(near) == [(0, 0)]
     tracker, _ = _slowing_walker(person.stamp, brisk_s_ago=5.0)  # slow for long: not slowing to a stop
-    tracker._stopping = tracker._stopping_at_own_readings(passer, person, Pose2D(), moving(person))
+    tracker._stopping = tracker._stopping_at_own_readings(passer, nothing_moving(person), person, Pose2D())
     assert tracker._associate(passer) == [(0, 0)]
