@@ -50,7 +50,8 @@ class PairingParams:
         simulated crowd's leg pairs seen as one object for walls. 0 turns it off.
     stance_partner : bool
         Pair a walking person's lone moving leg with their standing leg, a still
-        leg-shaped segment beside it (see ``PeopleTracker._stance_partners``).
+        leg-shaped segment beside it, or with their revealed far leg behind it when they
+        walk away from the laser (see ``PeopleTracker._stance_partners``).
     max_leg_spread_m : float
         Farthest a walking person's two legs lie apart across their heading: hip width and
         step width, with room for a turn the velocity has not caught up with yet. A pair

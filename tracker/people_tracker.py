@@ -539,9 +539,18 @@ class PeopleTracker:
         lies nearer the track's prediction than the leg does, is that person's leg pair:
         the candidate moves to the midpoint, with a leg pair's uncertainty. Nothing else
         changes: a leg no walking track owns is left alone (furniture beside a passer-by
-        starts nobody)."""
+        starts nobody).
+
+        The other leg of someone walking away from the laser is revealed (``OCCLUDED``)
+        behind where the earlier scans saw them, and partly hidden or sparse it often looks
+        less leg-like: without odometry (the world frame stays with the sensor) their near
+        leg, which comes towards the laser, is the lone moving one. So a still segment
+        holding revealed readings, at least as leg-like as the leg model's base rate, is a
+        partner too, when it lies at least a leg radius (``max_leg_radius_m``) farther
+        from the laser than the lone leg: behind it, not beside it."""
         lone = [k for k, c in enumerate(candidates) if c.kind == "leg"] if self.pairing.stance_partner else []
-        keep = leg_scores >= self.assoc.start_leg_probability
+        strong = leg_scores >= self.assoc.start_leg_probability
+        keep = strong | ((leg_scores >= self.leg_model.base_rate) & legs.touching(detection.labels == L.OCCLUDED))
         if not lone or not keep.any() or not walking:
             return candidates
         still = keep & ~legs.touching(self._object_readings(detection))
@@ -561,11 +570,15 @@ class PeopleTracker:
         at = {id(t): n for n, t in enumerate(everyone)}
         leg = np.array([index[candidates[k].object_ids[0]] for k in lone], dtype=np.int64)
         walker = [walking[groups[i]] if groups[i] >= 0 else None for i in leg]
+        # how much farther from the laser than the lone leg each partner must lie: a revealed,
+        # less leg-like one a leg radius (behind it), a leg-shaped one any distance
+        behind = np.where(strong[still], -np.inf, self.pairing.max_leg_radius_m)
         partner, mids = (_stance_kernel if compiled.on else _stance_partner_choice)(
             np.ascontiguousarray(s_xy), np.asarray(s_own, dtype=np.int64), np.ascontiguousarray(xy), leg,
             np.array([-2 if w is None else at.get(id(w), -1) for w in walker], dtype=np.int64),
             np.array([(np.nan, np.nan) if w is None else w.position for w in walker], dtype=float).reshape(-1, 2),
-            2.0 * self.pairing.max_leg_radius_m, float(self.pairing.max_leg_separation_m))
+            2.0 * self.pairing.max_leg_radius_m, float(self.pairing.max_leg_separation_m),
+            np.ascontiguousarray(behind), float(world.x), float(world.y))
         for n, k in enumerate(lone):
             if partner[n] >= 0:
                 out[k] = PersonCandidate(float(mids[n, 0]), float(mids[n, 1]), self.pairing.sigma_pair_m, "pair",
@@ -1236,23 +1249,27 @@ def tracks_in_sensor_frame(tracks: list[Track], pose: Pose2D) -> np.ndarray:
     return pose.inverse().transform_points(np.array([(t.x, t.y) for t in tracks]))
 
 
-def _stance_partner_choice(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d):
+def _stance_partner_choice(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d, behind, sensor_x, sensor_y):
     """Which still leg each lone moving leg of :meth:`PeopleTracker._stance_partners` pairs
     with, in the order given: for lone leg ``n`` (reading set ``leg[n]`` at ``xy[leg[n]]``,
     world frame, m; its walker at ``walker_xy[n]``, index ``walker_at[n]`` among the
     confirmed tracks, -1 when not among them, -2 when no walking track owns the leg), the
     nearest still leg ``s_xy[j]`` not taken by an earlier one, ``min_d``..``max_d`` metres
-    away, owned by nobody (``s_own[j]`` -1) or that walker, whose midpoint with the leg lies
-    nearer the walker than the leg does; -1 for none. Returns the partners and the pairs'
-    midpoints (the numpy reference of :func:`_stance_loop`)."""
+    away, at least ``behind[j]`` metres farther than the leg from the sensor at
+    (``sensor_x``, ``sensor_y``) (``-inf``: anywhere), owned by nobody (``s_own[j]`` -1) or
+    that walker, whose midpoint with the leg lies nearer the walker than the leg does; -1
+    for none. Returns the partners and the pairs' midpoints (the numpy reference of
+    :func:`_stance_loop`)."""
     partner = np.full(len(leg), -1, np.int64)
     mids_out = np.zeros((len(leg), 2))
     taken: set[int] = set()
+    s_range = np.hypot(s_xy[:, 0] - sensor_x, s_xy[:, 1] - sensor_y)
     for n, i in enumerate(leg):
         if walker_at[n] == -2:
             continue
         d = np.hypot(*(s_xy - xy[i]).T)
         ok = (d >= min_d) & (d <= max_d) & ((s_own < 0) | (s_own == walker_at[n]))
+        ok &= s_range - np.hypot(xy[i, 0] - sensor_x, xy[i, 1] - sensor_y) >= behind
         mids = 0.5 * (s_xy + xy[i])
         ok &= np.hypot(*(mids - walker_xy[n]).T) < np.hypot(*(xy[i] - walker_xy[n]))
         ok[list(taken)] = False
@@ -1264,7 +1281,7 @@ def _stance_partner_choice(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, ma
     return partner, mids_out
 
 
-def _stance_loop(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d):
+def _stance_loop(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d, behind, sensor_x, sensor_y):
     """:func:`_stance_partner_choice` in one compiled loop (numba), the same choices."""
     n_lone, n_still = len(leg), len(s_xy)
     partner = np.full(n_lone, -1, np.int64)
@@ -1276,9 +1293,12 @@ def _stance_loop(s_xy, s_own, xy, leg, walker_at, walker_xy, min_d, max_d):
         x, y = xy[leg[n], 0], xy[leg[n], 1]
         wx, wy = walker_xy[n, 0], walker_xy[n, 1]
         reach = np.hypot(x - wx, y - wy)
+        leg_range = np.hypot(x - sensor_x, y - sensor_y)
         best, best_d = -1, np.inf
         for j in range(n_still):
             if taken[j] or not (s_own[j] < 0 or s_own[j] == walker_at[n]):
+                continue
+            if not np.hypot(s_xy[j, 0] - sensor_x, s_xy[j, 1] - sensor_y) - leg_range >= behind[j]:
                 continue
             d = np.hypot(s_xy[j, 0] - x, s_xy[j, 1] - y)
             if not (d >= min_d and d <= max_d):

@@ -283,7 +283,8 @@ def test_best_leg_within_a_radius_agrees():
 
 def test_stance_partners_agree():
     """Lone moving legs choosing standing partners: the compiled loop and the numpy code
-    make the same choices, with several legs wanting the same partner and ties in distance."""
+    make the same choices, with several legs wanting the same partner, ties in distance and
+    partners that must lie behind the leg as seen from the sensor."""
     from people_tracker.tracker.people_tracker import _stance_kernel, _stance_partner_choice
     rng = np.random.default_rng(9)
     paired = 0
@@ -295,7 +296,8 @@ def test_stance_partners_agree():
         leg = rng.permutation(len(xy))[:n_legs].astype(np.int64)
         walker_at = rng.integers(-2, n_tracks, n_legs)
         walker_xy = xy[leg] + rng.normal(0, 0.3, (n_legs, 2))
-        args = (s_xy, s_own, xy, leg, walker_at, walker_xy, 0.1, 0.9)
+        behind = np.where(rng.random(n_still) < 0.5, -np.inf, 0.08)
+        args = (s_xy, s_own, xy, leg, walker_at, walker_xy, 0.1, 0.9, behind, *rng.uniform(-1, 3, 2))
         fast, ref = _stance_kernel(*args), _stance_partner_choice(*args)
         assert fast[0].tobytes() == ref[0].tobytes() and fast[1].tobytes() == ref[1].tobytes(), k
         paired += int((fast[0] >= 0).sum())

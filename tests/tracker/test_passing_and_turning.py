@@ -357,21 +357,27 @@ def test_a_new_track_gives_way_to_a_confirmed_one_when_in_doubt():
     assert tracker._associate([PersonCandidate(2.5, 0.0, 0.08, "leg")]) == [(0, 0)]
 
 
-def _lone_leg_case(prediction, owner=0, partner_score=0.9, standing=None):
-    """A scan with a walker's two legs (pillars at (3, 0) and (3, -0.4)); the one at y = 0
-    is their lone moving leg, the other stands still; the walker's track is predicted at
-    ``prediction`` and owns the moving leg when ``owner`` is 0; ``standing``: where someone
-    else's confirmed track stands still."""
+def _lone_leg_case(prediction, owner=0, partner_score=0.9, standing=None, partner=(3.0, -0.4), revealed=False):
+    """A scan with a walker's two legs (pillars at (3, 0) and ``partner``); the one at y = 0
+    is their lone moving leg, the other stands still (its readings revealed, ``OCCLUDED``,
+    when ``revealed``); the walker's track is predicted at ``prediction`` and owns the
+    moving leg when ``owner`` is 0; ``standing``: where someone else's confirmed track
+    stands still."""
     from types import SimpleNamespace
 
+    from people_tracker.detection import labels as L
     from people_tracker.detection.detector import Detection
     from people_tracker.detection.leg_features import leg_candidates
 
-    scan = _scan([[3.0, 0.0, 0.06], [3.0, -0.4, 0.06]])
+    scan = _scan([[3.0, 0.0, 0.06], [*partner, 0.06]])
     legs = leg_candidates(scan)
-    swinging = int(np.argmin(np.abs(legs.xy[:, 1])))
+    swinging = int(np.argmin(np.hypot(legs.xy[:, 0] - 2.95, legs.xy[:, 1])))
     moving = SimpleNamespace(object_id=7, beams=np.arange(legs.first_beam[swinging], legs.last_beam[swinging] + 1))
-    detection = Detection(np.zeros(scan.n_beams, dtype=np.int8), [moving], ())
+    labels = np.zeros(scan.n_beams, dtype=np.int8)
+    if revealed:
+        other = int(np.argmin(np.hypot(legs.xy[:, 0] - partner[0], legs.xy[:, 1] - partner[1])))
+        labels[legs.first_beam[other]:legs.last_beam[other] + 1] = L.OCCLUDED
+    detection = Detection(labels, [moving], ())
     lone = PersonCandidate(3.05, 0.0, 0.2, "leg", (7,))
     tracker = PeopleTracker.from_config(load_config())
     walker = SimpleNamespace(position=np.array(prediction, dtype=float), confirmed=True, still=False)
@@ -395,6 +401,24 @@ def test_a_lone_moving_leg_keeps_its_place_when_the_partner_leads_away_from_the_
     # someone standing there: the still leg is theirs (traced in the waiting room: a walker
     # stopping face to face with someone took their leg, slid onto them and was deleted)
     assert _lone_leg_case([3.05, -0.2], standing=[3.1, -0.5]).kind == "leg"
+
+
+def test_a_lone_moving_leg_pairs_with_a_less_leg_like_revealed_leg_behind_it():
+    """Someone walking away from a laser without odometry: the near leg comes towards the
+    laser (the lone moving one), the far leg is revealed behind it and scores below
+    ``start_leg_probability``. At the leg model's base rate or more, revealed and at least
+    a leg radius farther from the laser, it is the partner; beside the leg, or not
+    revealed, it is not."""
+    base = PeopleTracker.from_config(load_config()).leg_model.base_rate
+    weak = 0.5 * (base + load_config().association.start_leg_probability)
+    behind = _lone_leg_case([3.25, -0.1], partner=(3.45, -0.2), partner_score=weak, revealed=True)
+    assert behind.kind == "pair" and behind.sigma < 0.2
+    assert abs(behind.x - 3.25) < 0.04 and abs(behind.y + 0.1) < 0.03  # the two leg centres' midpoint
+    assert _lone_leg_case([3.25, -0.1], partner=(3.45, -0.2), partner_score=weak).kind == "leg"  # not revealed
+    assert _lone_leg_case([3.25, -0.1], partner=(3.45, -0.2), partner_score=0.5 * base, revealed=True).kind == "leg"
+    beside = _lone_leg_case([3.05, -0.2], partner_score=weak, revealed=True)  # (3, -0.4): as far as the leg
+    assert beside.kind == "leg"
+    assert _lone_leg_case([3.05, -0.2], partner_score=0.9, revealed=True).kind == "pair"  # leg-shaped: anywhere
 
 
 def test_stance_partners_bring_a_walkers_lone_legs_nearer_the_torso():
