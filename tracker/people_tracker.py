@@ -549,9 +549,11 @@ class PeopleTracker:
         partner too, when it lies at least a leg radius (``max_leg_radius_m``) farther
         from the laser than the lone leg: behind it, not beside it."""
         lone = [k for k, c in enumerate(candidates) if c.kind == "leg"] if self.pairing.stance_partner else []
+        if not lone or not walking:
+            return candidates
         strong = leg_scores >= self.assoc.start_leg_probability
         keep = strong | ((leg_scores >= self.leg_model.base_rate) & legs.touching(detection.labels == L.OCCLUDED))
-        if not lone or not keep.any() or not walking:
+        if not keep.any():
             return candidates
         still = keep & ~legs.touching(self._object_readings(detection))
         if not still.any():
