@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from people_tracker.models.pose import Pose2D
-from people_tracker.models.raycast import cast_rays
+from people_tracker.models.raycast import CircleMotion, cast_rays
 from people_tracker.models.scan import Scan
 
 
@@ -90,7 +90,8 @@ class LaserModel:
         return self.angle_min + np.arange(self.n_beams) * self.angle_increment
 
     def render(self, stamp: float, sensor_poses: list[Pose2D] | Pose2D, segments: np.ndarray,
-               circles: np.ndarray, rng: np.random.Generator | None = None) -> tuple[Scan, np.ndarray]:
+               circles: np.ndarray, rng: np.random.Generator | None = None,
+               moving: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[Scan, np.ndarray]:
         """Render one scan.
 
         Parameters
@@ -104,6 +105,12 @@ class LaserModel:
             The scene in the world frame (see :func:`people_tracker.models.raycast.cast_rays`).
         rng : numpy.random.Generator, optional
             Source of noise and dropouts; without it the scan is noise-free.
+        moving : (knot_times, knot_circles), optional
+            Circles that move during the sweep (people): ``knot_circles`` (shape (K, k, 3),
+            rows x, y, radius, world frame, metres) are where they are ``knot_times`` (shape
+            (K,), increasing) seconds after beam 0, in a straight line in between. Each beam
+            sees them where they are when it fires, as a real scanner sees a walker move on
+            during its sweep. Their hit indices follow those of ``circles``.
 
         Returns
         -------
@@ -126,7 +133,14 @@ class LaserModel:
         heading = yaws + angles
         origins = np.column_stack([xs, ys])
         directions = np.column_stack([np.cos(heading), np.sin(heading)])
-        dist, hit = cast_rays(origins, directions, segments, circles, self.range_max)
+        motion = None
+        if moving is not None and moving[1].shape[1]:
+            knot_times, knot_circles = moving
+            fixed = np.broadcast_to(circles[None, :, :2], (len(knot_times), len(circles), 2))
+            motion = CircleMotion(np.arange(n) * max(self.time_increment, 0.0), np.asarray(knot_times, dtype=float),
+                                  np.concatenate([fixed, knot_circles[:, :, :2]], axis=1))
+            circles = np.vstack([circles, knot_circles[0]])
+        dist, hit = cast_rays(origins, directions, segments, circles, self.range_max, motion)
         ranges = dist.copy()
         if rng is not None:
             finite = np.isfinite(ranges)

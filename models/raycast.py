@@ -2,11 +2,43 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 
+@dataclass(frozen=True)
+class CircleMotion:
+    """Circles that move while a scan's rays are cast (people walking on during a sweep).
+
+    Attributes
+    ----------
+    beam_times : ndarray, shape (n,)
+        When each ray is cast, seconds (any common origin).
+    knot_times : ndarray, shape (K,)
+        Increasing times, seconds, at which the centres are known.
+    knot_centres : ndarray, shape (K, k, 2)
+        Each circle's centre at each knot time, metres; in between a centre moves in a
+        straight line, and before the first (after the last) knot it stays at it.
+    """
+
+    beam_times: np.ndarray
+    knot_times: np.ndarray
+    knot_centres: np.ndarray
+
+    def centres(self, circle: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Centres (rows x, y) of circles ``circle`` at times ``t``, pairwise."""
+        kt, kc = self.knot_times, self.knot_centres
+        if len(kt) == 1:
+            return kc[0, circle]
+        i = np.clip(np.searchsorted(kt, t, side="right") - 1, 0, len(kt) - 2)
+        f = np.clip((t - kt[i]) / (kt[i + 1] - kt[i]), 0.0, 1.0)
+        return kc[i, circle] + f[:, None] * (kc[i + 1, circle] - kc[i, circle])
+
+
 def cast_rays_dense(origins: np.ndarray, directions: np.ndarray, segments: np.ndarray,
-              circles: np.ndarray, max_range: float) -> tuple[np.ndarray, np.ndarray]:
+                    circles: np.ndarray, max_range: float,
+                    motion: CircleMotion | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Distance along each ray to the first surface it meets, testing every ray against everything.
 
     The reference for :func:`cast_rays`, which gives the same answer faster.
@@ -23,6 +55,9 @@ def cast_rays_dense(origins: np.ndarray, directions: np.ndarray, segments: np.nd
         Circles as centre x, y and radius, metres.
     max_range : float
         Rays that meet nothing closer report ``inf``.
+    motion : CircleMotion, optional
+        Circles that move while the rays are cast (see :class:`CircleMotion`); their
+        ``circles`` rows give only the radii then.
 
     Returns
     -------
@@ -55,8 +90,14 @@ def cast_rays_dense(origins: np.ndarray, directions: np.ndarray, segments: np.nd
     k = circles.shape[0]
     if k:
         # |o + t d - c|² = r²  →  t² + 2 b t + cc = 0 with b = (o-c)·d, cc = |o-c|² - r²
-        fx = origins[:, 0:1] - circles[None, :, 0]
-        fy = origins[:, 1:2] - circles[None, :, 1]
+        if motion is None:
+            cx, cy = circles[None, :, 0], circles[None, :, 1]
+        else:
+            every = np.tile(np.arange(k), n)
+            at = motion.centres(every, np.repeat(motion.beam_times, k)).reshape(n, k, 2)
+            cx, cy = at[:, :, 0], at[:, :, 1]
+        fx = origins[:, 0:1] - cx
+        fy = origins[:, 1:2] - cy
         b = fx * directions[:, 0:1] + fy * directions[:, 1:2]
         cc = fx * fx + fy * fy - circles[None, :, 2] ** 2
         disc = b * b - cc
@@ -136,7 +177,8 @@ def _beam_ranges(headings, centre, half_width, everywhere):
 
 
 def cast_rays(origins: np.ndarray, directions: np.ndarray, segments: np.ndarray,
-              circles: np.ndarray, max_range: float) -> tuple[np.ndarray, np.ndarray]:
+              circles: np.ndarray, max_range: float,
+              motion: CircleMotion | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Distance along each ray to the first surface it meets.
 
     Same contract as :func:`cast_rays_dense`, for rays whose headings turn monotonically
@@ -151,6 +193,7 @@ def cast_rays(origins: np.ndarray, directions: np.ndarray, segments: np.ndarray,
     segments : ndarray, shape (m, 2, 2)
     circles : ndarray, shape (k, 3)
     max_range : float
+    motion : CircleMotion, optional
 
     Returns
     -------
@@ -164,8 +207,10 @@ def cast_rays(origins: np.ndarray, directions: np.ndarray, segments: np.ndarray,
     if n > 1 and headings[-1] < headings[0]:  # clockwise: work on the reversed beams
         order = np.arange(n)[::-1]
         origins, directions, headings = origins[order], directions[order], headings[order]
+        if motion is not None:
+            motion = CircleMotion(motion.beam_times[order], motion.knot_times, motion.knot_centres)
     if n > 1 and (np.diff(headings) < 0).any():
-        dist, hit = cast_rays_dense(origins, directions, segments, circles, max_range)
+        dist, hit = cast_rays_dense(origins, directions, segments, circles, max_range, motion)
         return (dist[order], hit[order]) if order is not None else (dist, hit)
     ref = origins.mean(axis=0)
     spread = float(np.hypot(*(origins - ref).T).max()) if n else 0.0
@@ -188,14 +233,19 @@ def cast_rays(origins: np.ndarray, directions: np.ndarray, segments: np.ndarray,
     k = circles.shape[0]
     if k:
         c, r = circles[:, :2], circles[:, 2]
+        reach = r + spread
+        if motion is not None:  # each beam tests where the circle can be over the whole sweep
+            c = motion.knot_centres.mean(axis=0)
+            reach = reach + np.hypot(*np.moveaxis(motion.knot_centres - c, 2, 0)).max(axis=0)
         v = c - ref
         dist_c = np.hypot(v[:, 0], v[:, 1])
-        inside = dist_c <= r + spread + 1e-6
-        half = np.arcsin(np.clip((r + spread) / np.maximum(dist_c, 1e-9), 0, 1))
+        inside = dist_c <= reach + 1e-6
+        half = np.arcsin(np.clip(reach / np.maximum(dist_c, 1e-9), 0, 1))
         pi_, bi = _beam_ranges(headings, np.arctan2(v[:, 1], v[:, 0]), half + 1e-9, inside)
         prim_parts.append(pi_ + m)
         beam_parts.append(bi)
-        t_parts.append(_ray_circle_t(origins[bi], directions[bi], c[pi_], r[pi_]))
+        at = c[pi_] if motion is None else motion.centres(pi_, motion.beam_times[bi])
+        t_parts.append(_ray_circle_t(origins[bi], directions[bi], at, r[pi_]))
     best = np.full(n, np.inf)
     hit = np.full(n, -1, dtype=np.int64)
     if prim_parts:

@@ -196,11 +196,16 @@ class TrackState:
             self.kf.P[:, i] = 0.0
             self.kf.P[i, i] = v
 
-    def update(self, z: np.ndarray, R: np.ndarray, moving: bool) -> None:
-        """Correct with a candidate position ``z`` (m) of covariance ``R`` (m²)."""
+    def update(self, z: np.ndarray, R: np.ndarray, moving: bool, after_s: float = 0.0) -> None:
+        """Correct with a candidate position ``z`` (world frame, m) of covariance ``R`` (m²),
+        seen ``after_s`` seconds after the state's stamp (the beams that saw it fired later
+        in the sweep): at constant velocity the person was ``velocity · after_s`` short of it
+        at the stamp."""
         # y = z - H x ; S = H P Hᵀ + R ; K = P Hᵀ S⁻¹ ; x = x + K y ; P = (I - K H) P (I - K H)ᵀ + K R Kᵀ
-        self.kf.x, self.kf.P = position_update(self.kf.x, self.kf.P, np.asarray(z, dtype=float),
-                                               np.asarray(R, dtype=float))
+        z = np.asarray(z, dtype=float)
+        if after_s > 0.0 and not self.still:
+            z = z - self.velocity * after_s
+        self.kf.x, self.kf.P = position_update(self.kf.x, self.kf.P, z, np.asarray(R, dtype=float))
         self.last_update = self.stamp
         self.seen_position = self.position.copy()
         self.hidden_position = None

@@ -8,7 +8,7 @@ import pytest
 from people_tracker.models.laser import LaserModel
 from people_tracker.models.person import PersonModel, Walker
 from people_tracker.models.pose import Pose2D
-from people_tracker.models.raycast import cast_rays
+from people_tracker.models.raycast import CircleMotion, cast_rays
 from people_tracker.models.scenario import ScenarioError, build_simulation, load_scenario, scenario_names
 from people_tracker.models.simulator import Simulation, visible_people
 from people_tracker.models.world import build_world
@@ -186,3 +186,36 @@ def test_culled_ray_caster_equals_the_dense_one(seed):
     d2, h2 = cast_rays_dense(origins, dirs, segments, circles, 12.0)
     np.testing.assert_allclose(d1, d2, rtol=1e-12, atol=1e-12)
     np.testing.assert_array_equal(h1[np.isfinite(d1)], h2[np.isfinite(d2)])
+    # the circles walking on during the sweep (up to 3 m/s, 0.1 s, a turn at a middle knot)
+    knots = circles[None, :, :2] + np.cumsum(rng.uniform(-0.15, 0.15, (3, 80, 2)), axis=0)
+    motion = CircleMotion(np.linspace(0, 0.1, n), np.array([0.0, 0.04, 0.1]), knots)
+    d1, h1 = cast_rays(origins, dirs, segments, circles, 12.0, motion)
+    d2, h2 = cast_rays_dense(origins, dirs, segments, circles, 12.0, motion)
+    np.testing.assert_allclose(d1, d2, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(h1[np.isfinite(d1)], h2[np.isfinite(d2)])
+    assert (h1 >= len(segments)).sum() > 20 and not np.allclose(d1, cast_rays(origins, dirs, segments, circles, 12.0)[0])
+
+
+@pytest.mark.parametrize("clockwise", [False, True])
+def test_a_walker_is_seen_where_they_are_when_each_beam_fires(clockwise):
+    """A scanner sweeps its beams over most of its period and people walk on meanwhile: each
+    reading of a walker lies on a leg where that leg is at the beam's time, not at the
+    stamp's (a still laser, a person crossing 2.5 m ahead of it at 1.5 m/s, seen mid-sweep)."""
+    laser = LaserModel(fov=math.radians(270), resolution=math.radians(0.33), rate_hz=7.5, range_max=11,
+                       noise_std=0.0, clockwise=clockwise)
+    walker = Walker(1, [[2.5, -4], [2.5, 4]], 1.5, body=PersonModel(0.06, 0.2, 0.6))
+    sim = Simulation(laser, build_world({}), [walker], np.random.default_rng(0), t0=0.0)
+    for _ in range(20):
+        step = sim.step()
+    scan, truth = step.scan, step.truth
+    t_scan = scan.stamp
+    on = np.flatnonzero(truth.beam_person == 1)
+    assert len(on) >= 10
+    pts = scan.points[on]  # the laser stands at the origin of the world, facing x
+    beam_t = t_scan + on * laser.time_increment
+    gap_then = [np.hypot(*(walker.legs(t)[:, None, :] - p).transpose(2, 0, 1)).min() - 0.06
+                for t, p in zip(beam_t, pts)]
+    gap_stamp = np.hypot(*(walker.legs(t_scan)[:, None, :] - pts[None]).transpose(2, 0, 1)).min(axis=0) - 0.06
+    assert np.abs(gap_then).max() < 0.03  # on the leg where it is when the beam fires
+    assert np.abs(gap_stamp).max() > 0.05  # not where it was at the stamp
+    np.testing.assert_allclose(truth.torso_world[0], walker.torso(t_scan))  # the truth: at the stamp
