@@ -267,14 +267,12 @@ class PeopleTracker:
         candidates = self._candidates(detection, world, legs, leg_scores)  # 3. legs paired into people (world frame)
         candidates += self._receding(detection, scan, world)  # 3b. walkers in their own shadow
         self._stopping = self._stopping_at_own_readings(candidates, detection, scan, world)
-        beams = {o.object_id: o.beams for o in detection.objects}
-        after_s = np.array([self._seen_after_stamp(c, beams, scan) for c in candidates])
         matched = self._associate(candidates)  # 4. associate candidates to tracks
         matched += self._recover(candidates, matched)  # 4b. re-join sharp turns the gate missed
         took = tuple((self._tracks[ti].track_id, ci) for ti, ci in matched)
         for ti, ci in matched:  # 5. update the matched tracks
             c = candidates[ci]
-            self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True, after_s=float(after_s[ci]))
+            self._tracks[ti].update(np.array([c.x, c.y]), c.R, moving=True)
         self._explained = self._object_readings(detection, {i for _, ci in matched for i in candidates[ci].object_ids})
         self._unmatchable_legs(scan, legs, leg_scores)  # 6. leg-shaped readings
         still = self._still_legs(legs) if self.standing.params.enabled else None
@@ -293,20 +291,24 @@ class PeopleTracker:
         self._delete(scan.stamp)  # 9. delete what the lifecycle rules end
         first = self._first_steps(scan.stamp)  # not reported yet
         target = self._follow(world, scan.stamp, first)  # 10. the followed person
-        reported = [t.report(target=(t.track_id == target)) for t in self._tracks if t.reported and t not in first]
+        shown = [t for t in self._tracks if t.reported and t not in first]
+        after_s = self._seen_after_stamp(np.array([t.position for t in shown]).reshape(-1, 2), scan, world)
+        reported = [t.report(target=(t.track_id == target), seen_after_s=float(a)) for t, a in zip(shown, after_s)]
         self.last = StepResult(reported, detection, candidates, world, scan, aligned, standing, legs, leg_scores, took)
         return reported
 
     @staticmethod
-    def _seen_after_stamp(candidate: PersonCandidate, beams: dict[int, np.ndarray], scan: Scan) -> float:
-        """Seconds after the scan's stamp (its first beam) at which the candidate's readings
-        were taken, on average: a scanner sweeps its beams over most of its period (0.1 s
-        for a 270° one at 7.5 Hz), and a walker moves on meanwhile. 0 for a candidate of no
-        moving object."""
-        if not candidate.object_ids or scan.time_increment <= 0:
-            return 0.0
-        index = np.concatenate([beams[i] for i in candidate.object_ids if i in beams] or [np.zeros(0)])
-        return float(index.mean()) * scan.time_increment if len(index) else 0.0
+    def _seen_after_stamp(xy: np.ndarray, scan: Scan, world: Pose2D) -> np.ndarray:
+        """Seconds after the scan's stamp (its first beam) at which its beams looked at the
+        places ``xy`` (world frame, m; shape (k, 2)): a scanner sweeps its beams over most of
+        its period (0.1 s for a 270° one at 7.5 Hz), and a walker moves on meanwhile. Places
+        outside the field of view take the nearest edge's beam."""
+        if not len(xy) or scan.time_increment <= 0 or scan.n_beams < 2:
+            return np.zeros(len(xy))
+        seen = world.inverse().transform_points(xy)
+        bearing = np.arctan2(seen[:, 1], seen[:, 0])
+        beam = np.clip((bearing - scan.angle_min) / scan.angle_increment, 0.0, scan.n_beams - 1)
+        return beam * scan.time_increment
 
     @staticmethod
     def _object_readings(detection: Detection, ids: set[int] | None = None) -> np.ndarray:

@@ -196,16 +196,11 @@ class TrackState:
             self.kf.P[:, i] = 0.0
             self.kf.P[i, i] = v
 
-    def update(self, z: np.ndarray, R: np.ndarray, moving: bool, after_s: float = 0.0) -> None:
-        """Correct with a candidate position ``z`` (world frame, m) of covariance ``R`` (m²),
-        seen ``after_s`` seconds after the state's stamp (the beams that saw it fired later
-        in the sweep): at constant velocity the person was ``velocity · after_s`` short of it
-        at the stamp."""
+    def update(self, z: np.ndarray, R: np.ndarray, moving: bool) -> None:
+        """Correct with a candidate position ``z`` (m) of covariance ``R`` (m²)."""
         # y = z - H x ; S = H P Hᵀ + R ; K = P Hᵀ S⁻¹ ; x = x + K y ; P = (I - K H) P (I - K H)ᵀ + K R Kᵀ
-        z = np.asarray(z, dtype=float)
-        if after_s > 0.0 and not self.still:
-            z = z - self.velocity * after_s
-        self.kf.x, self.kf.P = position_update(self.kf.x, self.kf.P, z, np.asarray(R, dtype=float))
+        self.kf.x, self.kf.P = position_update(self.kf.x, self.kf.P, np.asarray(z, dtype=float),
+                                               np.asarray(R, dtype=float))
         self.last_update = self.stamp
         self.seen_position = self.position.copy()
         self.hidden_position = None
@@ -301,8 +296,13 @@ class TrackState:
         return self.born_standing and not self.moved and not self.confirmed and \
             not self.existence.walked_or_arrived
 
-    def report(self, target: bool = False) -> Track:
+    def report(self, target: bool = False, seen_after_s: float = 0.0) -> Track:
+        """The track as reported at its stamp. The laser saw its place ``seen_after_s``
+        seconds after the stamp (its beams fire later in the sweep), and the filter follows
+        the person as seen: a walker is reported their velocity times that short of it."""
         x, vx, y, vy = (float(v) for v in self.kf.x)
+        if seen_after_s > 0.0 and not self.still:
+            x, y = x - vx * seen_after_s, y - vy * seen_after_s
         cov = self.position_cov
         status = "tentative" if not self.confirmed else ("confirmed" if self.updated_now else "coasting")
         return Track(self.track_id, x, y, vx, vy, ((float(cov[0, 0]), float(cov[0, 1])), (float(cov[1, 0]), float(cov[1, 1]))),

@@ -35,7 +35,7 @@ def _run(name: str, clockwise: bool, still: bool):
     sim, n = build_simulation(spec)
     sim.people_walk_in_sweep = False  # else the two lasers see each walker at other times
     tracker = PeopleTracker.from_config(load_config())
-    tracker._seen_after_stamp = lambda *a: 0.0  # and nothing walked on during a sweep to put back
+    tracker._seen_after_stamp = lambda xy, scan, world: np.zeros(len(xy))  # nor reported back along the sweep
     detections, tracks = [], []
     for _ in range(n):
         st = sim.step()
