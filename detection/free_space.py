@@ -177,6 +177,7 @@ class PlaceMemory:
         self.keyframe_s = keyframe_s
         self._frames: deque = deque(maxlen=max(1, int(round(memory_s / keyframe_s))) if keyframe_s > 0 else 1)
         self._xy: np.ndarray | None = None  # the keyframes' sensor positions (see _positions)
+        self._from_first = True  # the oldest keyframe is the first scan the laser took (none dropped yet)
 
     def add(self, scan: Scan, pose: Pose2D) -> None:
         """Offer a scan (sensor pose in the world frame); kept when a keyframe is due."""
@@ -184,31 +185,42 @@ class PlaceMemory:
             return
         if not self._frames or scan.stamp - self._frames[-1][0].stamp >= self.keyframe_s or \
                 scan.stamp < self._frames[-1][0].stamp:
+            if self._frames and (len(self._frames) == self._frames.maxlen or scan.stamp < self._frames[-1][0].stamp):
+                self._from_first = False
             self._frames.append((scan, pose))
             self._xy = None
 
     def history(self, xy_world: np.ndarray, before_s: float, radius_m: float,
-                no_return_free_m: float = np.inf, min_occupied_s: float = 10.0) -> str:
+                no_return_free_m: float = np.inf, min_occupied_s: float = 10.0,
+                min_occupied_from_first_s: float = 2.0) -> str:
         """``EMPTY`` when a keyframe older than ``before_s`` (a stamp, s) saw through the disc
         of ``radius_m`` around the place, else ``OCCUPIED_ONLY`` when keyframes worth at
         least ``min_occupied_s`` of time saw a return in it (a person passing by does not
-        make a place occupied), else ``UNKNOWN`` (never in view, or mostly hidden)."""
+        make a place occupied), or when every keyframe from the laser's first scan on saw a
+        return in it, worth at least ``min_occupied_from_first_s`` (occupied as long as the
+        laser has looked: a pillar a track slid onto in the first seconds of a recording),
+        else ``UNKNOWN`` (never in view, or mostly hidden)."""
         return self.histories(np.asarray(xy_world, dtype=float).reshape(1, 2), before_s, radius_m,
-                              no_return_free_m, min_occupied_s)[0]
+                              no_return_free_m, min_occupied_s, min_occupied_from_first_s=min_occupied_from_first_s)[0]
 
     def histories(self, xy_world: np.ndarray, before_s: float, radius_m: float,
                   no_return_free_m: float = np.inf, min_occupied_s: float = 10.0,
-                  viewpoint: np.ndarray | None = None, viewpoint_radius_m: float = np.inf) -> list[str]:
+                  viewpoint: np.ndarray | None = None, viewpoint_radius_m: float = np.inf,
+                  min_occupied_from_first_s: float = 2.0) -> list[str]:
         """:meth:`history` of each of several places (shape (k, 2), world frame, m), one pass
         over the keyframes; with ``viewpoint`` (a sensor position, world frame, m), only of
-        the keyframes taken within ``viewpoint_radius_m`` of it."""
+        the keyframes taken within ``viewpoint_radius_m`` of it (then the laser's first scan
+        counts as the first only when it was taken there)."""
         points = np.asarray(xy_world, dtype=float).reshape(-1, 2)
         empty = np.zeros(len(points), dtype=bool)
         occupied = np.zeros(len(points), dtype=np.int64)
         frames = list(self._frames)
+        from_first = self._from_first
         if viewpoint is not None and frames:
             near = np.hypot(*(self._positions() - np.asarray(viewpoint, dtype=float)).T) <= viewpoint_radius_m
+            from_first = from_first and bool(near[0])
             frames = [f for f, ok in zip(frames, near) if ok]
+        looked = 0
         for scan, pose in frames:
             if scan.stamp >= before_s or empty.all():
                 break
@@ -216,8 +228,12 @@ class PlaceMemory:
             code = place_visibility(points[open_], scan, pose, radius_m, no_return_free_m)
             empty[open_[code == SEEN_THROUGH]] = True
             occupied[open_] += code == OCCUPIED
-        return [self.EMPTY if e else self.OCCUPIED_ONLY if o * self.keyframe_s >= min_occupied_s else self.UNKNOWN
-                for e, o in zip(empty, occupied)]
+            looked += 1
+        # occupied in every keyframe since the laser's first scan: as long as it has looked
+        always = (occupied == looked) if from_first else np.zeros(len(points), dtype=bool)
+        return [self.EMPTY if e else self.OCCUPIED_ONLY
+                if o * self.keyframe_s >= min_occupied_s or (a and o * self.keyframe_s >= min_occupied_from_first_s)
+                else self.UNKNOWN for e, o, a in zip(empty, occupied, always)]
 
     def _positions(self) -> np.ndarray:
         """The keyframes' sensor positions (world frame, m), shape (n, 2), kept until the next keyframe."""
@@ -228,3 +244,4 @@ class PlaceMemory:
     def reset(self) -> None:
         self._frames.clear()
         self._xy = None
+        self._from_first = True

@@ -397,6 +397,31 @@ def test_one_segment_where_the_floor_was_seen_empty_from_here_starts_a_standing_
     assert always._tracks == [] and len(always._judged) == 1  # judged once, from here
 
 
+def test_a_place_occupied_since_the_lasers_first_scan_is_furniture_after_two_seconds():
+    """Traced in the simulated crowd: in its first seconds a walker's track slid onto a pillar
+    as they passed it and stood there for the rest of the scene, because a place counted as
+    only ever occupied after 10 s of keyframes. A place occupied in every keyframe from the
+    laser's first scan on is, once that is 2 s or more; one a keyframe saw empty is not; and
+    once the memory has dropped its first keyframe, the 10 s rule holds alone."""
+    from people_tracker.detection.free_space import PlaceMemory
+    from people_tracker.models.pose import Pose2D
+    place = np.array([3.0, 0.0])
+    memory = PlaceMemory(keyframe_s=1.0, memory_s=600.0)
+    for stamp in np.arange(0.0, 4.0, 0.1):
+        memory.add(_room_scan(stamp, (-2.0, 2.0)), Pose2D())
+    assert memory.history(place, 0.5, 0.25) == memory.UNKNOWN  # one keyframe: worth 1 s
+    assert memory.history(place, 1.5, 0.25) == memory.OCCUPIED_ONLY  # two, both occupied: worth 2 s
+    assert memory.history(place, 1.5, 0.25, min_occupied_from_first_s=np.inf) == memory.UNKNOWN
+    empty_first = PlaceMemory(keyframe_s=1.0, memory_s=600.0)
+    for stamp in np.arange(0.0, 4.0, 0.1):
+        empty_first.add(_room_scan(stamp, (-2.0, 2.0) if stamp >= 1.0 else None), Pose2D())
+    assert empty_first.history(place, 3.5, 0.25) == memory.EMPTY
+    short = PlaceMemory(keyframe_s=1.0, memory_s=3.0)  # keeps 3 keyframes: the first one goes
+    for stamp in np.arange(0.0, 6.0, 0.1):
+        short.add(_room_scan(stamp, (-2.0, 2.0)), Pose2D())
+    assert short.history(place, 5.5, 0.25) == memory.UNKNOWN
+
+
 def test_seen_empty_only_from_far_away_is_no_arrival():
     """The same segment, but the floor was seen empty only from where the laser no longer
     is (a robot that drove on: its world frame may have drifted, and a wall seen edge-on
