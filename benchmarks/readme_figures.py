@@ -83,22 +83,37 @@ def run_block(commands: list[str]) -> str:
 
 
 def regenerate(path: Path, only: str | None) -> int:
+    """Run the blocks of ``path`` (those with a command containing ``only``, if given) and
+    write their outputs in. The file is read again before it is written, and each output
+    goes to the block with its commands there: what was edited outside the blocks while the
+    commands ran (they may run for an hour) is kept."""
+    outputs: dict[str, str] = {}  # a block's opening marker -> its new console text
+    for m in BLOCK.finditer(path.read_text(encoding="utf-8")):
+        commands = [ln[2:] for ln in m.group("cmds").splitlines() if ln.startswith("$ ")]
+        if (only and not any(only in c for c in commands)) or m.group(1) in outputs:
+            continue
+        print(f"{path.name}: {commands[0][:100]}", file=sys.stderr, flush=True)
+        outputs[m.group(1)] = run_block(commands)
+    if not outputs:
+        return 0
     text = path.read_text(encoding="utf-8")
-    count = 0
+    found = set()
 
     def replace(m: re.Match) -> str:
-        nonlocal count
-        commands = [ln[2:] for ln in m.group("cmds").splitlines() if ln.startswith("$ ")]
-        if only and not any(only in c for c in commands):
+        if m.group(1) not in outputs:
             return m.group(0)
-        print(f"{path.name}: {commands[0][:100]}", file=sys.stderr, flush=True)
-        count += 1
-        return f"{m.group(1)}```console\n{run_block(commands)}\n```\n{m.group(4)}"
+        found.add(m.group(1))
+        return f"{m.group(1)}```console\n{outputs[m.group(1)]}\n```\n{m.group(4)}"
 
     new = BLOCK.sub(replace, text)
+    for marker in outputs.keys() - found:
+        print(f"readme_figures: {path.name}: the block of '{marker.splitlines()[1][2:80]}' was edited away while "
+              "its commands ran; its output is not written", file=sys.stderr)
     if new != text:
-        path.write_text(new, encoding="utf-8")
-    return count
+        tmp = path.with_name(f".{path.name}.figures-tmp")
+        tmp.write_text(new, encoding="utf-8")
+        os.replace(tmp, path)  # whole or not at all
+    return len(found)
 
 
 def main(argv: list[str] | None = None) -> int:

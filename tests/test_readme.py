@@ -63,3 +63,23 @@ def test_every_option_mentioned_exists_somewhere(helps):
                 if option == "--help" or any(w in code for w in ("pip ", "pytest", "python ")):
                     continue
                 assert re.search(rf"(^|[\s,\[]){re.escape(option)}\b", known), f"{doc.name}: no command has {option}"
+
+
+def test_figures_keep_what_was_edited_while_their_commands_ran(tmp_path):
+    """benchmarks/readme_figures.py runs a block's commands (up to an hour for all of them)
+    and then writes the output in; an edit made to the page meanwhile, outside the blocks, is
+    kept (it used to be overwritten by the page as it was read at the start)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("readme_figures", REPO / "benchmarks" / "readme_figures.py")
+    figures = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(figures)
+    page = tmp_path / "page.md"
+    # the block's command edits the page above the block, as someone would while it runs
+    edit = f"sed -i 's/^Before.$/Before, edited./' {page}"
+    page.write_text(f"Before.\n\n<!-- figures\n$ {edit}\n$ echo hello\n-->\n```console\nold\n```\n"
+                    "<!-- /figures -->\n\nAfter.\n", encoding="utf-8")
+    assert figures.regenerate(page, None) == 1
+    text = page.read_text(encoding="utf-8")
+    assert text.startswith("Before, edited.\n")
+    assert "```console\n$ " + edit + "\n$ echo hello\nhello\n```\n<!-- /figures -->\n\nAfter.\n" in text
+    assert "old" not in text
