@@ -27,7 +27,7 @@ from people_tracker.detection.leg_features import LegCandidates, leg_candidates
 from people_tracker.detection.segments import means_and_chords
 from people_tracker.models import compiled
 from people_tracker.models.leg_model import LegModel, load_leg_model
-from people_tracker.models.pose import Pose2D, best_within, pairwise_distances
+from people_tracker.models.pose import Pose2D, best_within, pairwise_distances, wrap_angle
 from people_tracker.models.scan import Scan, beam_index
 from people_tracker.tracker.association import associate, mahalanobis_costs
 from people_tracker.tracker.existence import Existence, ExistenceParams
@@ -309,10 +309,9 @@ class PeopleTracker:
         bearing = np.arctan2(seen[:, 1], seen[:, 0])
         beam = beam_index(bearing, scan.angle_min, scan.angle_increment, scan.n_beams)
         out = beam < 0
-        if out.any():  # behind the laser: the nearer end of the sweep
-            last = scan.angle_min + (scan.n_beams - 1) * scan.angle_increment
-            nearer_last = np.abs(np.angle(np.exp(1j * (bearing[out] - last)))) < \
-                np.abs(np.angle(np.exp(1j * (bearing[out] - scan.angle_min))))
+        if out.any():  # behind the laser: the nearer end of the sweep, the one on its side of the view's middle
+            middle = scan.angle_min + 0.5 * (scan.n_beams - 1) * scan.angle_increment
+            nearer_last = wrap_angle(bearing[out] - middle) * scan.angle_increment > 0
             beam[out] = np.where(nearer_last, scan.n_beams - 1, 0)
         return beam * scan.time_increment
 
