@@ -152,11 +152,7 @@ def load_leg_model(path: str | Path | None = None) -> LegModel:
     malformed file.
     """
     if path is None or str(path) == "default":
-        # beside this module: importlib.resources would take the first folder of a package
-        # spread over several (a source checkout installed editable over the __pycache__
-        # folders numba left in site-packages from an earlier regular install)
-        beside = Path(__file__).with_name(SHIPPED)
-        source = beside if beside.is_file() else resources.files(__package__).joinpath(SHIPPED)
+        source = resources.files(__package__).joinpath(SHIPPED)
         where = "the shipped leg model"
     else:
         source = Path(path)
