@@ -7,9 +7,13 @@ long chain of such operations, a kernel here does the same arithmetic in one com
 Every kernel has its numpy twin, which stays the reference: the kernel runs only when numba
 is installed (``pip install "people-tracker[fast]"``) and ``PEOPLE_TRACKER_COMPILED`` is not
 ``0``; ``tests/detection/test_compiled.py`` checks that the two give the same answers on real
-and simulated scans. Kernels are compiled on first use and cached beside the module that
-defines each (numba's ``cache=True``), so only the first run on a machine pays the
-compilation.
+and simulated scans. Kernels are compiled on first use and cached on disk (numba's
+``cache=True``), so only the first run on a machine pays the compilation. The cache lives in
+the user's cache folder (:func:`cache_dir`: ``$XDG_CACHE_HOME/people-tracker/numba`` or
+``~/.cache/people-tracker/numba`` on Linux), or in ``NUMBA_CACHE_DIR`` when that is set, never
+beside the installed modules: files written into ``site-packages/people_tracker`` outlive
+``pip uninstall``, and the folder they leave makes ``people_tracker`` a namespace package
+over a later editable install.
 
 The arithmetic follows the numpy code's order (the same expressions; a segment's sum in
 the order ``np.add.reduceat`` adds, :func:`reduceat_sum`), and numba does not fuse or
@@ -27,7 +31,9 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 
@@ -102,6 +108,20 @@ def _numpy_trig_is_the_c_librarys() -> bool:
 trig_is_numpys = ENABLED and _numpy_trig_is_the_c_librarys()
 
 
+def cache_dir() -> Path:
+    """Where the compiled kernels are kept when ``NUMBA_CACHE_DIR`` is not set: the
+    platform's per-user cache folder, ``people-tracker/numba`` inside it. Numba keeps one
+    subfolder per source folder (a hash of its full path), so an installed and an editable
+    copy never share a cache entry."""
+    if sys.platform == "win32":
+        base = os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local"
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Caches"
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "people-tracker" / "numba"
+
+
 KERNELS: list = []  # every kernel the pipeline calls (not the helpers they call), for the warm-up's test
 
 
@@ -110,7 +130,18 @@ def njit(fn, helper: bool = False):
     ``helper``: only called from other kernels (compiled into them)."""
     if _numba is None:
         return None
-    kernel = _numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")(fn)
+    # numba picks the cache's folder when the function is decorated, from config.CACHE_DIR
+    # (NUMBA_CACHE_DIR); set ours for this decoration only, so other numba users in the
+    # process keep theirs. A folder that cannot be written falls through to numba's own
+    # choices (beside the module if writable, else numba's per-user folder).
+    config = _numba.config
+    saved = config.CACHE_DIR
+    if not saved:
+        config.CACHE_DIR = str(cache_dir())
+    try:
+        kernel = _numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")(fn)
+    finally:
+        config.CACHE_DIR = saved
     if not helper:
         KERNELS.append(kernel)
     return kernel

@@ -606,3 +606,38 @@ def test_distances_leg_centres_and_touching_agree():
             assert f.shape == r.shape and f.tobytes() == r.tobytes(), k
         touched += int(ref[2].sum())
     assert touched > 200
+
+
+def _cache_paths(tmp_path: Path, **env: str) -> list[str]:
+    """Where a fresh process keeps every kernel's cache, and numba's CACHE_DIR after the
+    import (last line), with the environment ``env`` and without NUMBA_CACHE_DIR otherwise."""
+    import os
+    import subprocess
+    import sys
+    clean = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    code = ("import numba, people_tracker.tracker.people_tracker, people_tracker.detection.icp\n"
+            "from people_tracker.models import compiled\n"
+            "print('\\n'.join(k._cache.cache_path for k in compiled.KERNELS))\n"
+            "print(repr(numba.config.CACHE_DIR))\n")
+    out = subprocess.run([sys.executable, "-c", code], env={**clean, **env}, cwd=tmp_path,
+                         capture_output=True, text=True, check=True).stdout.splitlines()
+    assert len(out) > 10, out
+    return out
+
+
+def test_kernels_are_cached_in_the_users_cache_folder_not_beside_the_modules(tmp_path):
+    """Files numba writes beside the installed modules outlive ``pip uninstall``, and their
+    folder turns people_tracker into a namespace package over a later editable install."""
+    *paths, config_after = _cache_paths(tmp_path, XDG_CACHE_HOME=str(tmp_path / "xdg"))
+    package = Path(compiled.__file__).resolve().parents[1]
+    for p in paths:
+        assert Path(p).is_relative_to(tmp_path / "xdg" / "people-tracker" / "numba"), p
+        assert not Path(p).is_relative_to(package), p
+    assert config_after == "''", "numba's own cache setting is left as it was"
+
+
+def test_numba_cache_dir_set_by_the_user_wins(tmp_path):
+    *paths, config_after = _cache_paths(tmp_path, XDG_CACHE_HOME=str(tmp_path / "xdg"),
+                                        NUMBA_CACHE_DIR=str(tmp_path / "mine"))
+    assert all(Path(p).is_relative_to(tmp_path / "mine") for p in paths), paths[:3]
+    assert config_after == repr(str(tmp_path / "mine"))
