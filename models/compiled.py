@@ -122,6 +122,19 @@ def cache_dir() -> Path:
     return Path(base) / "people-tracker" / "numba"
 
 
+def uncompiled() -> int:
+    """How many kernels imported so far have no compiled copy on disk yet (no numba cache
+    index): a run that calls them compiles them first, about half a minute on the first run
+    on a machine. 0 without numba, and when numba keeps its cache where this cannot tell."""
+    n = 0
+    for kernel in KERNELS:
+        try:
+            n += not os.path.exists(kernel._cache._cache_file._index_path)
+        except AttributeError:  # a numba whose cache is laid out otherwise: unknown
+            return 0
+    return n
+
+
 KERNELS: list = []  # every kernel the pipeline calls (not the helpers they call), for the warm-up's test
 
 

@@ -176,6 +176,19 @@ def _progress(total: int, quiet: bool):
                 delay=2.0, leave=False, dynamic_ncols=True)
 
 
+def note_first_compile(log, terminal: bool | None = None) -> None:
+    """Say on stderr (through ``log``) that the compiled kernels are being compiled, when
+    none of them has a compiled copy on disk yet: the first run on a machine is otherwise
+    silent for about half a minute before its first scan. Only on a terminal (``terminal``:
+    whether stderr is one), as the progress bar: a script reading stderr gets no notes."""
+    from people_tracker.models import compiled
+
+    terminal = sys.stderr.isatty() if terminal is None else terminal
+    if terminal and compiled.ENABLED and compiled.uncompiled():
+        log.warning("compiling the fast kernels for this machine (once: about half a minute, then cached; "
+                    "PEOPLE_TRACKER_COMPILED=0 runs without them)")
+
+
 def _print_v_min(params, resolution: float) -> None:
     from people_tracker.detection.detector import v_min
 
@@ -289,6 +302,7 @@ def _run_loop(args, config, follow, source, stack, sink, truth, t0, interrupted=
         if leg_file:
             outputs.write_legs_header(leg_file)
         tracker = PeopleTracker.from_config(config, follow)
+        note_first_compile(log)
         _print_v_min(tracker.detector.params, rec.resolution)
         # what start-up made (the modules, the leg model) lives to the end: out of the cyclic
         # collector's sight, its full collections no longer walk it (~7 ms each, a few a
@@ -438,6 +452,10 @@ def _cmd_bench(args) -> int:
     data = Path(args.data or os.environ.get("PEOPLE_TRACKER_DATA") or "../shared/data")
     if args.data and not data.is_dir():
         raise InputError(f"data folder '{data}' does not exist")
+    import logging
+
+    import people_tracker.tracker.people_tracker  # noqa: F401  (its kernels, for the note below)
+    note_first_compile(logging.getLogger(PROG))
     run_bench(config, data, args.quick, sys.stdout, args.only)
     return 0
 

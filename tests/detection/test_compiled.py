@@ -8,6 +8,7 @@ which shapely takes from corners GEOS intersects in double-double precision and 
 from the same calipers' distances, agree to 1e-12 m (the centroids to the bit).
 """
 
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -374,17 +375,41 @@ def test_the_tracker_gives_the_same_with_and_without_kernels_on_the_real_recordi
     _tracker_agrees(steps, path.name)
 
 
-def test_the_warm_up_reaches_every_kernel():
+def test_the_warm_up_reaches_every_kernel(tmp_path):
     """What a live node runs before its first scan loads every kernel: none is left to
-    compile (or load) on a scan. In a fresh interpreter, so nothing else loaded them."""
+    compile (or load) on a scan. In a fresh interpreter, so nothing else loaded them, and
+    with an empty cache, so every kernel is compiled and :func:`compiled.uncompiled` (the
+    command line's first-run note) counts them all before and none after."""
+    import os
     import subprocess
     import sys
     code = ("from people_tracker.tracker.people_tracker import warm_up_kernels\n"
             "from people_tracker.models import compiled\n"
+            "before = compiled.uncompiled()\n"
             "warm_up_kernels()\n"
-            "print(len(compiled.KERNELS), [k.py_func.__qualname__ for k in compiled.KERNELS if not k.signatures])\n")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split(" ", 1)
-    assert int(out[0]) >= 8 and out[1].strip() == "[]", out
+            "print(len(compiled.KERNELS), before, compiled.uncompiled(), "
+            "[k.py_func.__qualname__ for k in compiled.KERNELS if not k.signatures])\n")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env=env).stdout.split(" ", 3)
+    assert int(out[0]) >= 8 and out[3].strip() == "[]", out
+    assert int(out[1]) == int(out[0]) and int(out[2]) == 0, out
+
+
+def test_the_command_line_says_when_it_compiles(monkeypatch, caplog):
+    from people_tracker.tracker.cli import note_first_compile
+    log = logging.getLogger("test")
+    monkeypatch.setattr(compiled, "uncompiled", lambda: 0)
+    with caplog.at_level(logging.WARNING):
+        note_first_compile(log, terminal=True)
+    assert not caplog.records  # compiled before: nothing to say
+    monkeypatch.setattr(compiled, "uncompiled", lambda: 3)
+    with caplog.at_level(logging.WARNING):
+        note_first_compile(log, terminal=False)
+    assert not caplog.records  # stderr read by a script: no notes
+    with caplog.at_level(logging.WARNING):
+        note_first_compile(log, terminal=True)
+    assert len(caplog.records) == 1 and "compiling" in caplog.records[0].getMessage()
 
 
 def test_track_filter_steps_agree():
