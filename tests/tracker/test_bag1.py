@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -67,15 +68,11 @@ def test_the_real_recordings_are_there():
     assert len(REAL_BAGS) >= 10
 
 
-@pytest.mark.parametrize("compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4],
-                         ids=["none", "bz2", "lz4"])
-def test_the_fast_reader_reads_compressed_chunks_as_rosbags_does(tmp_path, compression):
-    from tests_helpers import simulated_corridor
-
-    plain = simulated_corridor(tmp_path, "ros1", seconds=3.0)
-    out = tmp_path / "copy.bag"
+def _rewritten(plain: Path, out: Path, compression) -> Path:
+    """The bag ``plain`` written again to ``out`` in chunks of about 20 kB (several, so that
+    the merge across chunks is tested), compressed with ``compression`` (None: stored)."""
     writer = Writer(out)
-    writer.chunk_threshold = 20_000  # several chunks, so that the merge across chunks is tested
+    writer.chunk_threshold = 20_000
     if compression is not None:
         writer.set_compression(compression)
     src = _rosbags(plain)
@@ -87,6 +84,15 @@ def test_the_fast_reader_reads_compressed_chunks_as_rosbags_does(tmp_path, compr
                 writer.write(conns[c.id], t, raw)
     finally:
         src.close()
+    return out
+
+
+@pytest.mark.parametrize("compression", [None, Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4],
+                         ids=["none", "bz2", "lz4"])
+def test_the_fast_reader_reads_compressed_chunks_as_rosbags_does(tmp_path, compression):
+    from tests_helpers import simulated_corridor
+
+    out = _rewritten(simulated_corridor(tmp_path, "ros1", seconds=3.0), tmp_path / "copy.bag", compression)
     assert _same_as_rosbags(out) > 100
     reader = open_bag1(out)
     try:  # what was tested: several chunks, stored as asked
@@ -97,15 +103,112 @@ def test_the_fast_reader_reads_compressed_chunks_as_rosbags_does(tmp_path, compr
 
 
 def test_what_the_fast_reader_cannot_read_goes_to_rosbags(tmp_path, moving_bag):
-    cut = tmp_path / "cut.bag"
-    cut.write_bytes(moving_bag.read_bytes()[:200_000])  # no index: the end is gone
-    assert open_bag1(cut) is None
+    head = tmp_path / "head.bag"
+    head.write_bytes(moving_bag.read_bytes()[:5000])  # the bag's header and the start of a chunk, no message
+    assert open_bag1(head) is None
     with pytest.raises(Exception) as err:
-        open_bag(cut)
+        open_bag(head)
     assert "cannot be read as a ROS 1 bag" in str(err.value)
     other = tmp_path / "v13.bag"
     other.write_bytes(b"#ROSBAG V1.3\n" + bytes(100))
     assert open_bag1(other) is None
+
+
+def _all(reader) -> list[tuple]:
+    return [(c.id, c.topic, t, bytes(raw)) for c, t, raw in reader.messages()]
+
+
+def _record_ends(reader) -> dict[tuple, int]:
+    """Where in the file each message's record ends (an uncompressed bag), by (connection, time, bytes)."""
+    out = {}
+    for c in reader.connections:
+        time, _, offset, base = reader._index[c.id]
+        for t, at in zip(time.tolist(), (base + offset).tolist()):
+            a, n = reader._walk(reader._map, 0, 0, at)
+            out[(c.id, c.topic, t, bytes(reader._map[a:a + n]))] = a + n
+    return out
+
+
+def test_a_bag_cut_short_is_read_from_its_chunks(tmp_path, moving_bag, caplog):
+    """A recording cut short (the index at the end gone, and maybe the end of a chunk) gives
+    every message written in full before the cut, as 'rosbag reindex' would recover them,
+    and says so once."""
+    full = open_bag1(moving_bag)
+    try:
+        every, ends = _all(full), _record_ends(full)
+    finally:
+        full.close()
+    data = moving_bag.read_bytes()
+    for cut in (len(data) - 1000, len(data) // 2 + 12345, 4_100_000):  # in the index; mid-chunk; mid-message
+        path = tmp_path / f"cut{cut}.bag"
+        path.write_bytes(data[:cut])
+        reader = open_bag1(path)
+        try:
+            assert reader.repaired in ("its index cut off", "a damaged index")
+            want = [m for m in every if ends[m] <= cut]
+            assert _all(reader) == want and len(want) > 70
+            assert sum(c.msgcount for c in reader.connections) == len(want)
+            assert (reader.start_time, reader.end_time) == (min(m[2] for m in want), max(m[2] for m in want) + 1)
+        finally:
+            reader.close()
+    with caplog.at_level(logging.WARNING):
+        for _ in range(2):
+            open_bag(path).close()
+    said = [r.getMessage() for r in caplog.records if "cut short" in r.getMessage()]
+    assert len(said) == 1 and str(path) in said[0]
+
+
+def test_a_bag_never_closed_is_read_whole(tmp_path, moving_bag):
+    """``rosbag record`` killed leaves NAME.bag.active with no index (index_pos 0); its last
+    chunk may still carry size 0, the records written after its header."""
+    data = bytearray(moving_bag.read_bytes())
+    full = open_bag1(moving_bag)
+    try:
+        every = _all(full)
+        last = max(full._chunks)  # the last chunk's record, and where its records end
+        start, size, _ = full._chunks[last]
+    finally:
+        full.close()
+    at = data.index(b"index_pos=") + len(b"index_pos=")
+    data[at:at + 8] = bytes(8)  # not indexed
+    hlen = int.from_bytes(data[last:last + 4], "little")
+    size_at = data.index(b"size=", last, last + 4 + hlen) + len(b"size=")
+    data[size_at:size_at + 4] = bytes(4)  # the chunk's size not yet written ...
+    data[start - 4:start] = bytes(4)
+    active = tmp_path / "rec.bag.active"
+    active.write_bytes(bytes(data[:start + size]))  # ... and nothing after its records
+    reader = open_bag(active)
+    try:
+        assert reader.repaired == "no index" and _all(reader) == every
+    finally:
+        reader.close()
+
+
+@pytest.mark.parametrize("compression", [Writer.CompressionFormat.BZ2, Writer.CompressionFormat.LZ4], ids=["bz2", "lz4"])
+def test_a_compressed_bag_cut_short_keeps_its_whole_chunks(tmp_path, compression):
+    from tests_helpers import simulated_corridor
+
+    out = _rewritten(simulated_corridor(tmp_path, "ros1", seconds=3.0), tmp_path / "packed.bag", compression)
+    full = open_bag1(out)
+    try:
+        every = _all(full)
+        chunks = sorted(full._chunks.items())  # (record position, (data start, size, compression))
+        by_chunk = {}
+        for c in full.connections:
+            for cpos in full._index[c.id][1].tolist():
+                by_chunk[cpos] = by_chunk.get(cpos, 0) + 1
+    finally:
+        full.close()
+    (cpos, (start, size, _)) = chunks[len(chunks) // 2]
+    cut = tmp_path / "cut.bag"
+    cut.write_bytes(out.read_bytes()[:start + size // 2])  # halfway through a chunk
+    reader = open_bag1(cut)
+    try:
+        got = _all(reader)
+        assert reader.repaired == "its index cut off"
+        assert set(got) <= set(every) and len(got) == sum(n for p, n in by_chunk.items() if p < cpos) > 0
+    finally:
+        reader.close()
 
 
 def test_a_closed_fast_reader_reads_nothing(moving_bag):
@@ -187,3 +290,22 @@ def test_headers_read_at_once_and_field_by_field_agree(moving_bag, monkeypatch):
         assert [(c.id, t, raw) for c, t, raw in reader.messages(connections=conns)] == at_once
     finally:
         reader.close()
+
+
+def test_run_on_a_recording_cut_short_tracks_what_is_there(tmp_path, moving_bag):
+    """The command line on a cut recording: status 0, the warning once, and the tracks of
+    the scans it holds those of the whole recording (tracking looks only backwards)."""
+    from tests_helpers import run_cli
+
+    cut = tmp_path / "cut.bag"
+    cut.write_bytes(moving_bag.read_bytes()[:15_500_000])
+    proc = run_cli("run", str(cut), "--tracks", str(tmp_path / "cut.csv"))
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.count("a recording cut short?") == 1 and "368 read, 368 used" in proc.stdout, proc.stderr
+    assert run_cli("run", str(moving_bag), "-q", "--tracks", str(tmp_path / "full.csv")).returncode == 0
+
+    def rows(name, below=None):
+        lines = [line for line in (tmp_path / name).read_text().splitlines()[1:] if not line.startswith("#")]
+        return [line for line in lines if below is None or int(line.split(",")[0]) < below]
+    got = rows("cut.csv")
+    assert len(got) > 100 and got == rows("full.csv", below=368)

@@ -7,6 +7,7 @@ recording itself; a ROS 2 bag without them falls back to the standard ROS 2 type
 
 from __future__ import annotations
 
+import logging
 import struct
 from pathlib import Path
 
@@ -21,6 +22,9 @@ ODOMETRY = "nav_msgs/msg/Odometry"
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 PERSON_TYPES = ("leg_tracker/msg/Person", "leg_tracker/msg/PersonArray")
 
+log = logging.getLogger(__name__)
+_said_repaired: set[Path] = set()  # bags read from their chunks that a warning has named (once a bag)
+
 _STAMP_ROS1 = struct.Struct("<II")  # uint32 sec, uint32 nsec
 _STAMP_CDR_LE = struct.Struct("<iI")  # int32 sec, uint32 nanosec
 _STAMP_CDR_BE = struct.Struct(">iI")
@@ -30,7 +34,9 @@ def open_bag(path: str | Path) -> AnyReader:
     """Open a recording for reading, or raise :class:`InputError` naming what is wrong.
 
     A ROS 1 bag opens with :class:`~people_tracker.tracker.io.bag1.Bag1Reader` (the same
-    messages, read a few times faster) when that reader can read it, else with ``rosbags``."""
+    messages, read a few times faster) when that reader can read it, else with ``rosbags``.
+    A ROS 1 bag cut short (no index, or a damaged one; ``rosbag record``'s ``.bag.active``
+    file) is read from its chunks, with a warning the first time."""
     p = Path(path)
     if not p.exists():
         raise InputError(f"input '{p}' does not exist")
@@ -40,13 +46,19 @@ def open_bag(path: str | Path) -> AnyReader:
         if not (p / "metadata.yaml").is_file():
             raise InputError(f"input '{p}' is a folder but not a ROS 2 bag (it has no metadata.yaml)")
     else:
-        if p.suffix not in (".bag", ".mcap", ".db3"):
+        if not _is_ros1(p) and p.suffix not in (".mcap", ".db3"):
             raise InputError(f"input '{p}' is not a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), "
                              "or an .mcap or .db3 file")
         if p.stat().st_size == 0:
             raise InputError(f"input '{p}' is empty")
-    kind = "ROS 1 bag" if p.suffix == ".bag" else "ROS 2 recording"
-    if p.suffix == ".bag" and (fast := open_bag1(p)) is not None:
+    ros1 = _is_ros1(p)
+    kind = "ROS 1 bag" if ros1 else "ROS 2 recording"
+    if ros1 and (fast := open_bag1(p)) is not None:
+        if fast.repaired and p.resolve() not in _said_repaired:
+            _said_repaired.add(p.resolve())
+            log.warning(f"input '{p}' has {fast.repaired} (a recording cut short?): read from its chunks as "
+                        f"'rosbag reindex' would, {sum(c.msgcount for c in fast.connections)} messages; "
+                        "what was being written when it stopped is lost")
         return fast
     try:
         reader = AnyReader([p], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
@@ -54,6 +66,12 @@ def open_bag(path: str | Path) -> AnyReader:
     except Exception as exc:  # rosbags raises several types for unreadable files
         raise InputError(f"input '{p}' cannot be read as a {kind}: {_one_line(exc)}") from None
     return reader
+
+
+def _is_ros1(p: Path) -> bool:
+    """Whether ``p`` names a ROS 1 bag: ``.bag``, or ``.bag.active`` (``rosbag record``'s
+    file while it records, left so when the recording is killed)."""
+    return p.suffix == ".bag" or p.name.endswith(".bag.active")
 
 
 def _one_line(exc: BaseException) -> str:

@@ -15,8 +15,14 @@ Chunks stored uncompressed are read in place; bz2 and lz4 chunks are decompresse
 ``rosbags`` does, one at a time.
 
 :func:`open_bag1` returns None for anything it does not read (another bag version, an
-unindexed or encrypted bag, a record it cannot parse), and the caller then opens the file
-with ``rosbags``, whose error messages stay those users see for a damaged file.
+encrypted bag, a record it cannot parse), and the caller then opens the file with
+``rosbags``, whose error messages stay those users see for a damaged file.
+
+A bag with no index or a damaged one, as a recording cut short leaves it (``rosbag record``
+killed, its ``.bag.active`` file; a disk that filled up; a copy cut off), is read from its
+chunks instead, walked from the start as ``rosbag reindex`` walks them (:attr:`Bag1Reader.repaired`
+says why): every complete chunk, and of an uncompressed chunk cut short, every message
+written in full before the cut.
 ``tests/tracker/test_bag1.py`` checks that both readers give the same connections, the same
 messages in the same order and the same decoded messages on every real recording.
 """
@@ -61,6 +67,22 @@ def _fields(buf: bytes) -> dict[bytes, bytes]:
     return out
 
 
+def _header_at(buf, at: int, end: int) -> tuple[dict[bytes, bytes], int, int] | None:
+    """The record at ``at`` of ``buf`` (read up to ``end``): its header fields, where its
+    data starts and the data's length as the record gives it (which may reach past
+    ``end``); None when its header is cut short or cannot be parsed."""
+    if at + 8 > end:
+        return None
+    data = at + 4 + _U32.unpack_from(buf, at)[0]
+    if data + 4 > end:
+        return None
+    try:
+        fields = _fields(buf[at + 4:data])
+    except _Unreadable:
+        return None
+    return fields, data + 4, _U32.unpack_from(buf, data)[0]
+
+
 def _get(fields: dict[bytes, bytes], name: bytes, fmt: struct.Struct):
     value = fields.get(name)
     if value is None or len(value) != fmt.size:
@@ -74,6 +96,7 @@ class Bag1Reader:
     ``messages``, ``deserialize``, ``close`` and ``stack`` (not None while open)."""
 
     is2 = False
+    repaired: str | None = None  # why the index was rebuilt from the chunks (None: read from the bag's index)
 
     def __init__(self, path: Path) -> None:
         self.path = path
@@ -123,8 +146,19 @@ class Bag1Reader:
         (index_pos,) = _get(header, b"index_pos", _U64)
         (conn_count,) = _get(header, b"conn_count", _U32)
         (chunk_count,) = _get(header, b"chunk_count", _U32)
-        if index_pos == 0 or chunk_count == 0:
-            raise _Unreadable("not indexed, or empty")
+        if index_pos == 0:
+            self._read_chunks("no index")
+            return
+        if chunk_count == 0:
+            raise _Unreadable("empty")
+        try:
+            self._read_indexed(index_pos, conn_count, chunk_count)
+        except (_Unreadable, struct.error, ValueError, UnicodeDecodeError):
+            self._read_chunks("a damaged index" if index_pos < len(m) else "its index cut off")
+
+    def _read_indexed(self, index_pos: int, conn_count: int, chunk_count: int) -> None:
+        """The connections and every message's place from the index at ``index_pos``."""
+        m = self._map
         pos = index_pos
         self.connections: list[Connection] = []
         for _ in range(conn_count):
@@ -171,6 +205,11 @@ class Bag1Reader:
                 entries = np.frombuffer(m[start:start + size], dtype=_INDEX_ENTRY)
                 parts[conn].append((entries, cpos))
                 pos = after
+        self._build_index(parts)
+
+    def _build_index(self, parts: dict[int, list]) -> None:
+        """Each connection's messages from ``parts`` (connection id -> a list of (index
+        entries, chunk position)), and the connections' message counts."""
         # per connection: each message's bag time (ns), chunk, offset in the chunk's records,
         # and where those records start in the file (the record's place, for uncompressed chunks)
         self._index: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -185,6 +224,90 @@ class Bag1Reader:
             self._index[conn] = (time, where, offset, base)
         self.connections = [Connection(c.id, c.topic, c.msgtype, c.msgdef, c.digest, len(self._index[c.id][0]),
                                         c.ext, c.owner) for c in self.connections]
+
+    def _read_chunks(self, why: str) -> None:
+        """The connections and every message's place read from the chunks themselves, walked
+        from the first record after the bag's header to where the file ends or stops making
+        sense, as ``rosbag reindex`` does (the bag has ``why``: no index, or a damaged one).
+        A chunk cut short keeps the messages written in full before the cut when it is
+        uncompressed (its size may also still be 0, as ``rosbag record`` leaves the chunk it
+        was writing); a compressed one cut short is lost."""
+        m = self._map
+        _, _, _, pos = self._record(len(_MAGIC))  # the bag's header record
+        conns: dict[int, Connection] = {}
+        entries: dict[int, list[tuple[int, int, int, int]]] = {}  # conn -> (sec, nsec, offset, chunk position)
+        self._chunks = {}
+        self._chunk_pos, self._chunk = -1, b""
+        while (head := _header_at(m, pos, len(m))) is not None:
+            fields, start, dlen = head
+            op, end = fields.get(b"op"), start + dlen
+            if op == bytes([_OP_CHUNK]):
+                compression = fields.get(b"compression", b"")
+                if compression not in (b"none", b"bz2", b"lz4"):
+                    break
+                if compression == b"none" and (dlen == 0 or end > len(m)):  # still being written, or cut short
+                    walked = self._walk_chunk(m, start, len(m), pos, conns, entries)
+                    self._chunks[pos] = (start, walked - start, compression)
+                    break  # nothing after it can be trusted
+                if end > len(m):
+                    break  # a compressed chunk cut short: lost
+                self._chunks[pos] = (start, dlen, compression)
+                records, chunk_base = self._chunk_data(pos)
+                self._walk_chunk(records, chunk_base, chunk_base + (dlen if compression == b"none" else len(records)),
+                                 pos, conns, entries)
+            elif op == bytes([_OP_CONNECTION]):  # the index's copy of a connection
+                if end > len(m):
+                    break
+                try:
+                    conn = self._connection(fields, m[start:end])
+                except (_Unreadable, UnicodeDecodeError):
+                    break
+                conns.setdefault(conn.id, conn)
+            elif op not in (bytes([_OP_INDEX_DATA]), bytes([_OP_CHUNK_INFO])):
+                break
+            pos = end
+        self._chunk_pos, self._chunk = -1, b""
+        if not entries:
+            raise _Unreadable(f"{why}, and no message could be read from its chunks")
+        self.connections = [conns[k] for k in sorted(conns)]
+        parts: dict[int, list] = {k: [] for k in conns}
+        for conn, rows in entries.items():
+            by_chunk: dict[int, list] = {}
+            for sec, nsec, off, cpos in rows:
+                by_chunk.setdefault(cpos, []).append((sec, nsec, off))
+            parts[conn] = [(np.array(v, dtype=_INDEX_ENTRY), cpos) for cpos, v in by_chunk.items()]
+        times = [e["sec"].astype(np.int64) * 10**9 + e["nsec"] for chunks in parts.values() for e, _ in chunks]
+        all_times = np.concatenate(times)
+        self.start_time, self.end_time = int(all_times.min()), int(all_times.max()) + 1
+        self._build_index(parts)
+        self.repaired = why
+
+    def _walk_chunk(self, records, at: int, end: int, cpos: int, conns: dict, entries: dict) -> int:
+        """Note every connection and message record of one chunk's ``records``, from ``at``
+        to ``end`` (the chunk at ``cpos``); stops at a record cut short or not a chunk's.
+        Returns where the last whole record ends."""
+        first = at
+        while (head := _header_at(records, at, end)) is not None:
+            fields, data, dlen = head
+            if data + dlen > end:
+                break
+            op = fields.get(b"op")
+            try:
+                if op == bytes([_OP_MSG_DATA]):
+                    (conn,) = _get(fields, b"conn", _U32)
+                    sec, nsec = _get(fields, b"time", _TIME)
+                    if conn not in conns:
+                        break  # a message of no connection seen: not a record of this chunk
+                    entries.setdefault(conn, []).append((sec, nsec, at - first, cpos))
+                elif op == bytes([_OP_CONNECTION]):
+                    conn = self._connection(fields, records[data:data + dlen])
+                    conns.setdefault(conn.id, conn)
+                else:
+                    break
+            except (_Unreadable, UnicodeDecodeError):
+                break
+            at = data + dlen
+        return at
 
     def _connection(self, fields: dict[bytes, bytes], data: bytes) -> Connection:
         (conn,) = _get(fields, b"conn", _U32)
