@@ -29,9 +29,16 @@ def test_corrupt_input(tmp_path, name):
 
 
 def test_truncated_real_recording(tmp_path):
+    """Cut short, a bag is read as far as it goes, with one warning; with no message left
+    in it, it is one line and status 2."""
     src = data_file("leigh/positive_1.bag")
     (tmp_path / "cut.bag").write_bytes(src.read_bytes()[: 300_000])
-    assert_one_line_error(run_cli("run", str(tmp_path / "cut.bag")), "cut.bag")
+    proc = run_cli("run", str(tmp_path / "cut.bag"))
+    assert proc.returncode == 0 and "92 read, 92 used" in proc.stdout, proc.stderr
+    assert proc.stderr.startswith("people-tracker: warning: input") and proc.stderr.count("\n") == 1, proc.stderr
+    assert "has its index cut off (a recording cut short?)" in proc.stderr
+    (tmp_path / "head.bag").write_bytes(src.read_bytes()[: 5000])
+    assert_one_line_error(run_cli("run", str(tmp_path / "head.bag")), "head.bag")
 
 
 def test_not_a_recording(tmp_path):
