@@ -41,3 +41,23 @@ def simulated_corridor(folder: Path, fmt: str, seconds: float = 2.0) -> Path:
     proc = run_cli("simulate", "corridor", "--output", str(out), "--duration", str(seconds), "--format", fmt)
     assert proc.returncode == 0, proc.stderr
     return out
+
+
+def copy_messages(source: Path, writer, digest_key: str):
+    """Every message of the recording ``source`` written again, in order, with ``writer`` (a
+    rosbags writer, not yet open; ``digest_key``: its add_connection's name for the type's
+    hash, ``md5sum`` for ROS 1, ``rihs01`` for ROS 2). Returns the writer, closed."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    src = AnyReader([source], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+    src.open()
+    try:
+        with writer:
+            conns = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data, **{digest_key: c.digest})
+                     for c in src.connections}
+            for c, t, raw in src.messages():
+                writer.write(conns[c.id], t, raw)
+    finally:
+        src.close()
+    return writer

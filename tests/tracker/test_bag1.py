@@ -71,19 +71,13 @@ def test_the_real_recordings_are_there():
 def _rewritten(plain: Path, out: Path, compression) -> Path:
     """The bag ``plain`` written again to ``out`` in chunks of about 20 kB (several, so that
     the merge across chunks is tested), compressed with ``compression`` (None: stored)."""
+    from tests_helpers import copy_messages
+
     writer = Writer(out)
     writer.chunk_threshold = 20_000
     if compression is not None:
         writer.set_compression(compression)
-    src = _rosbags(plain)
-    try:
-        with writer:
-            conns = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data, md5sum=c.digest)
-                     for c in src.connections}
-            for c, t, raw in src.messages():
-                writer.write(conns[c.id], t, raw)
-    finally:
-        src.close()
+    copy_messages(plain, writer, "md5sum")
     return out
 
 

@@ -16,6 +16,7 @@ from rosbags.typesys import Stores, get_typestore
 
 from people_tracker.tracker.errors import InputError
 from people_tracker.tracker.io.bag1 import open_bag1
+from people_tracker.tracker.io.mcap_cut import open_mcap_cut
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
 ODOMETRY = "nav_msgs/msg/Odometry"
@@ -23,7 +24,7 @@ TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 PERSON_TYPES = ("leg_tracker/msg/Person", "leg_tracker/msg/PersonArray")
 
 log = logging.getLogger(__name__)
-_said_repaired: set[Path] = set()  # bags read from their chunks that a warning has named (once a bag)
+_said: set[tuple[Path, str]] = set()  # the warnings said of each recording (each once)
 
 _STAMP_ROS1 = struct.Struct("<II")  # uint32 sec, uint32 nsec
 _STAMP_CDR_LE = struct.Struct("<iI")  # int32 sec, uint32 nanosec
@@ -35,8 +36,11 @@ def open_bag(path: str | Path) -> AnyReader:
 
     A ROS 1 bag opens with :class:`~people_tracker.tracker.io.bag1.Bag1Reader` (the same
     messages, read a few times faster) when that reader can read it, else with ``rosbags``.
-    A ROS 1 bag cut short (no index, or a damaged one; ``rosbag record``'s ``.bag.active``
-    file) is read from its chunks, with a warning the first time."""
+    A recording cut short is read as far as it goes, with a warning the first time: a ROS 1
+    bag with no index or a damaged one (``rosbag record``'s ``.bag.active`` file) from its
+    chunks, an MCAP file with no summary or end record by record
+    (:mod:`~people_tracker.tracker.io.mcap_cut`), and a ROS 2 bag folder with one MCAP file
+    and no ``metadata.yaml`` (a recorder stopped before writing it) through that file."""
     p = Path(path)
     if not p.exists():
         raise InputError(f"input '{p}' does not exist")
@@ -44,7 +48,12 @@ def open_bag(path: str | Path) -> AnyReader:
         p = p.parent
     if p.is_dir():
         if not (p / "metadata.yaml").is_file():
-            raise InputError(f"input '{p}' is a folder but not a ROS 2 bag (it has no metadata.yaml)")
+            files = sorted(p.glob("*.mcap"))
+            if len(files) != 1:  # a recorder stopped before writing its metadata leaves its one file
+                raise InputError(f"input '{p}' is a folder but not a ROS 2 bag (it has no metadata.yaml)")
+            _warn_once(p, f"input '{p}' has no metadata.yaml (a recording cut short?): reading its one file, "
+                          f"{files[0].name}")
+            p = files[0]
     else:
         if not _is_ros1(p) and p.suffix not in (".mcap", ".db3"):
             raise InputError(f"input '{p}' is not a ROS 1 .bag, a ROS 2 bag folder (or its metadata.yaml), "
@@ -54,18 +63,39 @@ def open_bag(path: str | Path) -> AnyReader:
     ros1 = _is_ros1(p)
     kind = "ROS 1 bag" if ros1 else "ROS 2 recording"
     if ros1 and (fast := open_bag1(p)) is not None:
-        if fast.repaired and p.resolve() not in _said_repaired:
-            _said_repaired.add(p.resolve())
-            log.warning(f"input '{p}' has {fast.repaired} (a recording cut short?): read from its chunks as "
-                        f"'rosbag reindex' would, {sum(c.msgcount for c in fast.connections)} messages; "
-                        "what was being written when it stopped is lost")
+        if fast.repaired:
+            _warn_once(p, f"input '{p}' has {fast.repaired} (a recording cut short?): read from its chunks as "
+                          f"'rosbag reindex' would, {sum(c.msgcount for c in fast.connections)} messages; "
+                          "what was being written when it stopped is lost")
         return fast
     try:
         reader = AnyReader([p], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()
     except Exception as exc:  # rosbags raises several types for unreadable files
-        raise InputError(f"input '{p}' cannot be read as a {kind}: {_one_line(exc)}") from None
+        mcap = _one_mcap(p)
+        cut = open_mcap_cut(mcap) if mcap is not None else None
+        if cut is None:
+            raise InputError(f"input '{p}' cannot be read as a {kind}: {_one_line(exc)}") from None
+        _warn_once(p, f"input '{p}' cannot be read whole ({_one_line(exc).rstrip('.')}; a recording cut "
+                      f"short?): read record by record, {sum(c.msgcount for c in cut.connections)} messages; "
+                      "what was being written when it stopped is lost")
+        return cut
     return reader
+
+
+def _warn_once(p: Path, text: str) -> None:
+    """``text`` as a warning, the first time it is said of the recording ``p``."""
+    if (p.resolve(), text) not in _said:
+        _said.add((p.resolve(), text))
+        log.warning(text)
+
+
+def _one_mcap(p: Path) -> Path | None:
+    """The MCAP file ``p`` is, or the one a ROS 2 bag folder ``p`` holds; else None."""
+    if p.is_file():
+        return p if p.suffix == ".mcap" else None
+    files = sorted(p.glob("*.mcap"))
+    return files[0] if len(files) == 1 else None
 
 
 def _is_ros1(p: Path) -> bool:

@@ -39,6 +39,8 @@ from rosbags.interfaces import Connection, ConnectionExtRosbag1, MessageDefiniti
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.msg import normalize_msgtype
 
+from people_tracker.tracker.io.mapped import MappedRecording
+
 _MAGIC = b"#ROSBAG V2.0\n"
 _U32 = struct.Struct("<I")
 _U64 = struct.Struct("<Q")
@@ -90,7 +92,7 @@ def _get(fields: dict[bytes, bytes], name: bytes, fmt: struct.Struct):
     return fmt.unpack(value)
 
 
-class Bag1Reader:
+class Bag1Reader(MappedRecording):
     """An open, indexed ROS 1 (v2.0) bag with the parts of ``rosbags.highlevel.AnyReader``
     the tracker uses: ``connections``, ``start_time`` and ``end_time`` (ns), ``is2``,
     ``messages``, ``deserialize``, ``close`` and ``stack`` (not None while open)."""
@@ -99,19 +101,7 @@ class Bag1Reader:
     repaired: str | None = None  # why the index was rebuilt from the chunks (None: read from the bag's index)
 
     def __init__(self, path: Path) -> None:
-        self.path = path
-        self._file = path.open("rb")
-        try:
-            self._map = mmap.mmap(self._file.fileno(), 0, access=mmap.ACCESS_READ)
-        except BaseException:
-            self._file.close()
-            raise
-        self.stack = self  # not None while open, as AnyReader's
-        try:
-            self._read_index()
-        except BaseException:
-            self.close()
-            raise
+        super().__init__(path)  # maps the file and reads its index (_read)
         self._typestore = get_typestore(Stores.EMPTY)
         self._registered: set[str] = set()
         self._chunk_pos = -1
@@ -122,6 +112,9 @@ class Bag1Reader:
         self._u8 = np.frombuffer(self._map, dtype=np.uint8) if plain else None
 
     # ----- the index, read on opening
+    def _read(self) -> None:
+        self._read_index()
+
     def _record(self, pos: int) -> tuple[dict[bytes, bytes], int, int, int]:
         """The record at ``pos``: (header fields, data start, data length, next record)."""
         m = self._map
@@ -411,14 +404,9 @@ class Bag1Reader:
             self._registered.add(msgtype)
         return self._typestore.deserialize_ros1(raw, msgtype)
 
-    def close(self) -> None:
-        if self.stack is None:
-            return
-        self.stack = None
+    def _release(self) -> None:
         self._chunk = b""
         self._u8 = None  # the file's bytes as an array hold the map open
-        self._map.close()
-        self._file.close()
 
 
 # the message headers an uncompressed bag's messages() reads at once: few first (the caller

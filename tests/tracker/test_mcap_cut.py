@@ -1,0 +1,132 @@
+"""An MCAP recording cut short (a recorder killed, power lost, a copy cut off) is read as far
+as it goes: every message written in full before the cut, as rosbags reads the whole file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as Writer2
+from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+from rosbags.typesys import Stores, get_typestore
+from tests_helpers import copy_messages, run_cli, simulated_corridor
+
+from people_tracker.tracker.io.bag import open_bag
+from people_tracker.tracker.io.mcap_cut import McapCutReader, open_mcap_cut
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory) -> Path:
+    """40 s of the simulated corridor (odometry, /tf, /tf_static) as an MCAP bag: several chunks."""
+    return simulated_corridor(tmp_path_factory.mktemp("mcap"), "mcap", seconds=40.0)
+
+
+def _mcap(folder: Path) -> Path:
+    return next(folder.glob("*.mcap"))
+
+
+def _messages(reader) -> list[tuple]:
+    return [(c.topic, c.msgtype, t, bytes(raw)) for c, t, raw in reader.messages()]
+
+
+def _ends(reader: McapCutReader) -> list[int]:
+    """Where in the file each message (in the order messages() gives them) ends: stored chunks only."""
+    return [(reader._chunks[k][0] if k >= 0 else 0) + at + n for _, _, k, at, n in reader._rows.tolist()]
+
+
+def test_a_whole_file_reads_as_rosbags_reads_it(recorded):
+    slow = AnyReader([recorded], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+    slow.open()
+    fast = McapCutReader(_mcap(recorded))
+    try:
+        assert fast.repaired is None and len(fast._chunks) >= 3  # what is tested: several chunks
+        assert [(c.topic, c.msgtype, c.msgcount) for c in fast.connections] == \
+            [(c.topic, c.msgtype, c.msgcount) for c in slow.connections]
+        every = _messages(slow)
+        assert _messages(fast) == every and len(every) > 1000
+        assert (fast.start_time, fast.end_time) == (slow.start_time, slow.end_time)
+        decoded: dict[str, int] = {}
+        for (c, _, raw), (cs, _, raw_s) in zip(fast.messages(), slow.messages()):
+            if decoded.get(c.msgtype, 0) < 3:
+                decoded[c.msgtype] = decoded.get(c.msgtype, 0) + 1
+                assert repr(fast.deserialize(raw, c.msgtype)) == repr(slow.deserialize(raw_s, cs.msgtype))
+        assert len(decoded) >= 3
+    finally:
+        slow.close()
+        fast.close()
+
+
+def test_a_file_cut_short_keeps_every_message_written_in_full(tmp_path, recorded):
+    whole = McapCutReader(_mcap(recorded))
+    try:
+        every, ends = _messages(whole), _ends(whole)
+    finally:
+        whole.close()
+    data = _mcap(recorded).read_bytes()
+    for cut in (len(data) - 100, len(data) * 2 // 3, len(data) // 4 + 7):  # in the summary; in chunks
+        path = tmp_path / f"cut{cut}.mcap"
+        path.write_bytes(data[:cut])
+        reader = open_mcap_cut(path)
+        try:
+            want = [m for m, end in zip(every, ends) if end <= cut]
+            assert reader.repaired == ("its summary cut off" if want == every else "its end cut off")
+            assert _messages(reader) == want and len(want) > 100
+        finally:
+            reader.close()
+
+
+def test_a_compressed_file_cut_short_keeps_its_whole_chunks(tmp_path, recorded):
+    out = tmp_path / "zstd"
+    writer = Writer2(out, version=9, storage_plugin=StoragePlugin.MCAP)
+    writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+    copy_messages(recorded, writer, "rihs01")
+    whole = McapCutReader(_mcap(out))
+    try:
+        assert {compression for _, _, compression, _ in whole._chunks} == {"zstd"} and len(whole._chunks) >= 3
+        every, chunk_of = _messages(whole), whole._rows[:, 2].tolist()
+        second = whole._chunks[1]
+    finally:
+        whole.close()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(_mcap(out).read_bytes()[:second[0] + second[1] // 2])  # halfway through the second chunk
+    reader = open_mcap_cut(cut)
+    try:
+        assert _messages(reader) == [m for m, k in zip(every, chunk_of) if k < 1] != []
+    finally:
+        reader.close()
+
+
+def test_run_on_a_recording_folder_cut_short(tmp_path, recorded):
+    """A recorder killed leaves its folder with one MCAP file cut short and no
+    metadata.yaml: the command line reads what is there, says so, and tracks it as it
+    tracks the same scans of the whole recording."""
+    folder = tmp_path / "killed"
+    folder.mkdir()
+    data = _mcap(recorded).read_bytes()
+    (folder / "killed_0.mcap").write_bytes(data[:len(data) // 2])
+    proc = run_cli("run", str(folder), "--tracks", str(tmp_path / "cut.csv"))
+    assert proc.returncode == 0, proc.stderr
+    assert "no metadata.yaml" in proc.stderr and "cannot be read whole" in proc.stderr, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 2, proc.stderr
+    assert run_cli("run", str(recorded), "-q", "--tracks", str(tmp_path / "whole.csv")).returncode == 0
+
+    def rows(name: str) -> list[str]:
+        return [line for line in (tmp_path / name).read_text().splitlines()[1:] if not line.startswith("#")]
+    got = rows("cut.csv")
+    last = int(got[-1].split(",")[0])
+    assert len(got) > 50 and got == [r for r in rows("whole.csv") if int(r.split(",")[0]) <= last]
+    reader = open_bag(folder)  # and it reads as the reader above does
+    try:
+        assert isinstance(reader, McapCutReader)
+    finally:
+        reader.close()
+
+
+def test_nothing_readable_is_still_one_line(tmp_path, recorded):
+    head = tmp_path / "head.mcap"
+    head.write_bytes(_mcap(recorded).read_bytes()[:20])
+    proc = run_cli("run", str(head))
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert "cannot be read as a ROS 2 recording" in proc.stderr
