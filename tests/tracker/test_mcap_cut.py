@@ -130,3 +130,11 @@ def test_nothing_readable_is_still_one_line(tmp_path, recorded):
     proc = run_cli("run", str(head))
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert "cannot be read as a ROS 2 recording" in proc.stderr
+
+
+def test_a_sqlite_bag_folder_without_its_metadata_is_read_through_its_file(tmp_path):
+    folder = simulated_corridor(tmp_path, "sqlite3", seconds=2.0)
+    (folder / "metadata.yaml").unlink()
+    proc = run_cli("run", str(folder))
+    assert proc.returncode == 0 and "20 read, 20 used" in proc.stdout, proc.stderr
+    assert proc.stderr.count("no metadata.yaml") == 1, proc.stderr

@@ -48,7 +48,7 @@ def open_bag(path: str | Path) -> AnyReader:
         p = p.parent
     if p.is_dir():
         if not (p / "metadata.yaml").is_file():
-            files = sorted(p.glob("*.mcap"))
+            files = sorted([*p.glob("*.mcap"), *p.glob("*.db3")])
             if len(files) != 1:  # a recorder stopped before writing its metadata leaves its one file
                 raise InputError(f"input '{p}' is a folder but not a ROS 2 bag (it has no metadata.yaml)")
             _warn_once(p, f"input '{p}' has no metadata.yaml (a recording cut short?): reading its one file, "
