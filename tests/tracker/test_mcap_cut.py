@@ -138,3 +138,15 @@ def test_a_sqlite_bag_folder_without_its_metadata_is_read_through_its_file(tmp_p
     proc = run_cli("run", str(folder))
     assert proc.returncode == 0 and "20 read, 20 used" in proc.stdout, proc.stderr
     assert proc.stderr.count("no metadata.yaml") == 1, proc.stderr
+
+
+def test_a_split_recording_without_its_metadata_says_what_to_do(tmp_path, recorded):
+    folder = tmp_path / "split"
+    folder.mkdir()
+    for k in range(2):
+        (folder / f"split_{k}.mcap").write_bytes(_mcap(recorded).read_bytes())
+    proc = run_cli("run", str(folder))
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert "2 recording files" in proc.stderr and "ros2 bag reindex" in proc.stderr
+    proc = run_cli("run", str(folder / "split_1.mcap"), "-q")  # one of them, on its own
+    assert proc.returncode == 0, proc.stderr

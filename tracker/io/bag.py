@@ -49,8 +49,13 @@ def open_bag(path: str | Path) -> AnyReader:
     if p.is_dir():
         if not (p / "metadata.yaml").is_file():
             files = sorted([*p.glob("*.mcap"), *p.glob("*.db3")])
-            if len(files) != 1:  # a recorder stopped before writing its metadata leaves its one file
+            if len(files) > 1:  # split files: their order and the cut one's place are in the metadata
+                raise InputError(f"input '{p}' has no metadata.yaml and {len(files)} recording files "
+                                 "(a split recording cut short?): give one file, or write the metadata "
+                                 "with 'ros2 bag reindex'")
+            if not files:
                 raise InputError(f"input '{p}' is a folder but not a ROS 2 bag (it has no metadata.yaml)")
+            # a recorder stopped before writing its metadata leaves its one file
             _warn_once(p, f"input '{p}' has no metadata.yaml (a recording cut short?): reading its one file, "
                           f"{files[0].name}")
             p = files[0]
