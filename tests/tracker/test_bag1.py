@@ -303,3 +303,28 @@ def test_run_on_a_recording_cut_short_tracks_what_is_there(tmp_path, moving_bag)
         return [line for line in lines if below is None or int(line.split(",")[0]) < below]
     got = rows("cut.csv")
     assert len(got) > 100 and got == rows("full.csv", below=368)
+
+
+def test_a_bag_chunk_that_does_not_decompress_ends_the_recording_there(tmp_path):
+    from tests_helpers import simulated_corridor
+
+    out = _rewritten(simulated_corridor(tmp_path, "ros1", seconds=3.0), tmp_path / "bz2.bag",
+                     Writer.CompressionFormat.BZ2)
+    full = open_bag1(out)
+    try:
+        every = _all(full)
+        chunks = sorted(full._chunks.items())
+        in_first = sum(int((full._index[c.id][1] == chunks[0][0]).sum()) for c in full.connections)
+    finally:
+        full.close()
+    start, size, _ = chunks[1][1]
+    data = bytearray(out.read_bytes())
+    data[start:start + 64] = bytes(64)  # the second chunk's compressed bytes spoilt
+    bad = tmp_path / "bad.bag"
+    bad.write_bytes(bytes(data[:start + size]))
+    reader = open_bag1(bad)
+    try:
+        got = _all(reader)
+        assert len(got) == in_first > 0 and set(got) <= set(every)
+    finally:
+        reader.close()

@@ -150,3 +150,26 @@ def test_a_split_recording_without_its_metadata_says_what_to_do(tmp_path, record
     assert "2 recording files" in proc.stderr and "ros2 bag reindex" in proc.stderr
     proc = run_cli("run", str(folder / "split_1.mcap"), "-q")  # one of them, on its own
     assert proc.returncode == 0, proc.stderr
+
+
+def test_a_chunk_that_does_not_decompress_ends_the_recording_there(tmp_path, recorded):
+    """Garbage where a compressed chunk's bytes should be (a disk error, a bad copy): the
+    chunks before it are read, with no error from the decompressor."""
+    out = tmp_path / "zstd"
+    writer = Writer2(out, version=9, storage_plugin=StoragePlugin.MCAP)
+    writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+    copy_messages(recorded, writer, "rihs01")
+    whole = McapCutReader(_mcap(out))
+    try:
+        every, chunk_of, second = _messages(whole), whole._rows[:, 2].tolist(), whole._chunks[1]
+    finally:
+        whole.close()
+    data = bytearray(_mcap(out).read_bytes())
+    data[second[0]:second[0] + 64] = bytes(64)  # the second chunk's first bytes zeroed
+    bad = tmp_path / "bad.mcap"
+    bad.write_bytes(bytes(data[:second[0] + second[1]]))  # and the file ends after it
+    reader = open_mcap_cut(bad)
+    try:
+        assert _messages(reader) == [m for m, k in zip(every, chunk_of) if k < 1] != []
+    finally:
+        reader.close()

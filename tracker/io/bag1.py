@@ -245,7 +245,11 @@ class Bag1Reader(MappedRecording):
                 if end > len(m):
                     break  # a compressed chunk cut short: lost
                 self._chunks[pos] = (start, dlen, compression)
-                records, chunk_base = self._chunk_data(pos)
+                try:
+                    records, chunk_base = self._chunk_data(pos)
+                except Exception:  # noqa: BLE001 - a chunk that does not decompress (bz2, lz4 raise several types): the cut
+                    del self._chunks[pos]
+                    break
                 self._walk_chunk(records, chunk_base, chunk_base + (dlen if compression == b"none" else len(records)),
                                  pos, conns, entries)
             elif op == bytes([_OP_CONNECTION]):  # the index's copy of a connection

@@ -103,8 +103,9 @@ class McapCutReader(MappedRecording):
                 self._chunks.append((data, stored if whole else len(m) - data, compression, size))
                 try:
                     records = self._chunk_records(k)
-                except McapUnreadable:
+                except Exception:  # noqa: BLE001 - one that does not decompress (lz4, zstd raise their own types): the cut
                     self._chunks.pop()
+                    self._chunk_at, self._chunk = -1, b""
                     break
                 self._records(records, 0, len(records), k, rows)
                 if not whole:
