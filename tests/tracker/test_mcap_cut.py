@@ -77,11 +77,16 @@ def test_a_file_cut_short_keeps_every_message_written_in_full(tmp_path, recorded
             reader.close()
 
 
-def test_a_compressed_file_cut_short_keeps_its_whole_chunks(tmp_path, recorded):
-    out = tmp_path / "zstd"
+def _zstd_copy(recorded: Path, out: Path) -> Path:
+    """The recording written again as an MCAP bag with zstd-compressed chunks."""
     writer = Writer2(out, version=9, storage_plugin=StoragePlugin.MCAP)
     writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
     copy_messages(recorded, writer, "rihs01")
+    return out
+
+
+def test_a_compressed_file_cut_short_keeps_its_whole_chunks(tmp_path, recorded):
+    out = _zstd_copy(recorded, tmp_path / "zstd")
     whole = McapCutReader(_mcap(out))
     try:
         assert {compression for _, _, compression, _ in whole._chunks} == {"zstd"} and len(whole._chunks) >= 3
@@ -155,10 +160,7 @@ def test_a_split_recording_without_its_metadata_says_what_to_do(tmp_path, record
 def test_a_chunk_that_does_not_decompress_ends_the_recording_there(tmp_path, recorded):
     """Garbage where a compressed chunk's bytes should be (a disk error, a bad copy): the
     chunks before it are read, with no error from the decompressor."""
-    out = tmp_path / "zstd"
-    writer = Writer2(out, version=9, storage_plugin=StoragePlugin.MCAP)
-    writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
-    copy_messages(recorded, writer, "rihs01")
+    out = _zstd_copy(recorded, tmp_path / "zstd")
     whole = McapCutReader(_mcap(out))
     try:
         every, chunk_of, second = _messages(whole), whole._rows[:, 2].tolist(), whole._chunks[1]
