@@ -117,17 +117,11 @@ class Bag1Reader(MappedRecording):
 
     def _record(self, pos: int) -> tuple[dict[bytes, bytes], int, int, int]:
         """The record at ``pos``: (header fields, data start, data length, next record)."""
-        m = self._map
-        if pos + 4 > len(m):
-            raise _Unreadable("a record lies beyond the end of the file")
-        hlen = _U32.unpack_from(m, pos)[0]
-        data = pos + 4 + hlen
-        if data + 4 > len(m):
-            raise _Unreadable("a record lies beyond the end of the file")
-        dlen = _U32.unpack_from(m, data)[0]
-        if data + 4 + dlen > len(m):
-            raise _Unreadable("a record lies beyond the end of the file")
-        return _fields(m[pos + 4:data]), data + 4, dlen, data + 4 + dlen
+        head = _header_at(self._map, pos, len(self._map))
+        if head is None or head[1] + head[2] > len(self._map):
+            raise _Unreadable("a record lies beyond the end of the file, or its header cannot be parsed")
+        fields, start, dlen = head
+        return fields, start, dlen, start + dlen
 
     def _read_index(self) -> None:
         m = self._map
@@ -273,10 +267,9 @@ class Bag1Reader(MappedRecording):
             for sec, nsec, off, cpos in rows:
                 by_chunk.setdefault(cpos, []).append((sec, nsec, off))
             parts[conn] = [(np.array(v, dtype=_INDEX_ENTRY), cpos) for cpos, v in by_chunk.items()]
-        times = [e["sec"].astype(np.int64) * 10**9 + e["nsec"] for chunks in parts.values() for e, _ in chunks]
-        all_times = np.concatenate(times)
-        self.start_time, self.end_time = int(all_times.min()), int(all_times.max()) + 1
         self._build_index(parts)
+        times = np.concatenate([time for time, _, _, _ in self._index.values()])
+        self.start_time, self.end_time = int(times.min()), int(times.max()) + 1
         self.repaired = why
 
     def _walk_chunk(self, records, at: int, end: int, cpos: int, conns: dict, entries: dict) -> int:
