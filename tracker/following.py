@@ -11,7 +11,9 @@ track at that place — when exactly one is there; when more than one could be t
 person is reported lost rather than swapped for someone else. An ``auto`` selector (the
 robot follows whoever it locked onto in front of it) gives a lost person's id instead to
 the one person in front of the robot after a moment, if there is exactly one (of several,
-the one clearly walking as the person last walked, by their world-frame velocity): a robot
+the one clearly walking as the person last walked, by their world-frame velocity; a track
+not confirmed yet beyond the lock zone, where the person could be, counts as one, since
+far away the person's own track is confirmed slowly): a robot
 following someone has them in front of it, wherever a drifting or turned estimate says
 they went, and the one track near that estimate was more often a passer-by than them. A
 track that walks neither as the person last walked nor as the robot that follows them now
@@ -255,9 +257,17 @@ class TargetSelector:
         return self.steady is not None and float(np.hypot(*(np.asarray(q) - self.steady))) > self.slide_m
 
     def reacquire(self, stamp: float, others: dict[int, np.ndarray],
-                  velocities: dict[int, np.ndarray] | None = None) -> int | None:
+                  velocities: dict[int, np.ndarray] | None = None,
+                  pending: dict[int, np.ndarray] | None = None) -> int | None:
         """Which other track (id → sensor-frame place) takes over the missing target's id
-        (``velocities``: id → world-frame velocity, m/s, when known)."""
+        (``velocities``: id → world-frame velocity, m/s, when known, ``pending`` included).
+
+        ``pending``: tracks updated this scan but not yet reported (id → sensor-frame place,
+        m). ``auto`` counts those beyond the lock zone's range among the ones it looks among,
+        though none of them takes the id: far away, a walker's few readings a leg confirm a
+        track slowly, and the person seen there may not be reported yet while a passer-by
+        nearer is the only reported track; with two there, the person is reported lost
+        rather than given to the wrong one."""
         if self.lost_since is None or self.target is None:
             return None
         if self.mode != "auto":  # the id goes to the one track within reach of where they should be
@@ -267,12 +277,16 @@ class TargetSelector:
                 return None
             best = self.only_one_near(stamp, others)
         elif stamp - self.lost_since >= self.relock_s:  # the person is the one in front of the robot
-            looked = self.looked_for(stamp, others)
+            far = {tid: q for tid, q in (pending or {}).items() if math.hypot(*q) > self._lock_range}
+            everyone = {**others, **far}
+            looked = self.looked_for(stamp, everyone)
             if velocities is not None:  # walking as neither the person nor the robot that follows them: a passer-by
                 looked = [tid for tid in looked if self.walks_as_expected(velocities.get(tid))]
-            best = self._only_one(looked, others)
+            best = self._only_one(looked, everyone)
             if best is None:
                 best = self._walking_on(looked, velocities)
+            if best in far:  # not reported yet: the id waits for it
+                best = None
             if best is not None:  # where they are now is learnt afresh
                 self._forget_place()
         else:

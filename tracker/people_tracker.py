@@ -1216,7 +1216,9 @@ class PeopleTracker:
                     sel.lost(stamp, "coasting, another track where they should be")
             if sel.lost_since is not None:
                 others = [u for u in self._tracks if u.track_id != sel.target and u.reported and u not in unreported]
-                new_id = sel.reacquire(stamp, here(others), {u.track_id: u.velocity for u in others})
+                pending = [u for u in self._tracks if u.track_id != sel.target and not u.reported and u.updated_now]
+                new_id = sel.reacquire(stamp, here(others), {u.track_id: u.velocity for u in others + pending},
+                                       here(pending))
                 if new_id is not None:
                     for u in self._tracks:  # the id's old track, if it lives on unreported, is not them
                         if u.track_id == sel.target:

@@ -105,6 +105,27 @@ def test_a_lost_person_is_looked_for_as_far_ahead_as_they_could_have_gone():
     assert TargetSelector("auto").choose({7: beyond_zone}) is None  # the first lock keeps to the zone
 
 
+def test_a_far_track_not_yet_confirmed_where_the_lost_person_could_be_holds_the_re_lock_back():
+    passer_by = np.array([1.6, 1.4])  # in the lock zone, the only reported track
+    far_walker = np.array([5.0, 0.4])  # beyond the zone, where the person could have gone: not confirmed yet
+    near_walker = np.array([2.5, -0.5])  # a track not confirmed yet, inside the zone
+
+    def lost_at_the_zones_edge() -> TargetSelector:
+        sel = TargetSelector("auto", lock_range_m=3.5, reacquire_m=0.8, walk_mps=1.5, relock_s=1.0)
+        sel.target = 1
+        sel.seen(0.0, np.array([3.4, 0.2]))
+        sel.lost(0.1)
+        return sel
+
+    assert lost_at_the_zones_edge().reacquire(1.2, {7: passer_by}) == 7
+    sel = lost_at_the_zones_edge()
+    assert sel.reacquire(1.2, {7: passer_by}, pending={12: far_walker}) is None  # two where they may be: lost
+    assert sel.reacquire(1.3, {}, pending={12: far_walker}) is None  # the id waits for it to be reported
+    assert sel.reacquire(1.4, {12: far_walker}) == 12
+    # inside the zone, tracks confirm within a few scans: one not confirmed yet holds nothing back
+    assert lost_at_the_zones_edge().reacquire(1.2, {7: passer_by}, pending={13: near_walker}) == 7
+
+
 def test_a_lost_person_followed_automatically_is_not_handed_to_whoever_is_where_they_should_be():
     sel = TargetSelector("auto")
     sel.target = 1
