@@ -85,6 +85,8 @@ class TargetSelector:
         has stayed off for ``steady_s``: after a gap the average would take a large share of
         the jump at once, and a track that came back on a passer-by would drag the person's
         place onto them before the person's own new track is seen where they are.
+        A target track that stood still in the world frame all the while has not slid
+        (:meth:`only_the_sensor_moved`).
     trail_s : float
         ... unless that other track was farther than ``reacquire_m`` from the averaged place
         ``trail_s`` seconds ago (or where it began, if later): it walked in from elsewhere, a
@@ -119,6 +121,7 @@ class TargetSelector:
         self.settle_s, self.settle_margin_m = settle_s, settle_margin_m
         self._locked_at: float | None = None  # when the first lock was made (s)
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
+        self._world: deque = deque()  # (stamp s, place m): where the target's track was in the world frame, lately
         self._slid_since: float | None = None  # since when (s) the target's updates have been off ``steady``
         self._q: np.ndarray | None = None  # the person's place in the sensor frame (m) ...
         self._v = np.zeros(2)  # ... its rate of change (m/s) ...
@@ -133,10 +136,16 @@ class TargetSelector:
         self._path_s = sensor_velocity_s
         self._path: deque = deque()  # (stamp s, x m, y m): the sensor's place in the world frame, lately
 
-    def seen(self, stamp: float, q: np.ndarray, velocity: np.ndarray | None = None) -> None:
-        """The target's track was updated at ``stamp`` (s), at ``q`` in the sensor frame (m),
-        walking at ``velocity`` (world frame, m/s; None when not known)."""
+    def seen(self, stamp: float, q: np.ndarray, velocity: np.ndarray | None = None,
+             world: np.ndarray | None = None) -> None:
+        """The target's track was updated at ``stamp`` (s), at ``q`` in the sensor frame (m)
+        and ``world`` in the world frame (m; None when not known), walking at ``velocity``
+        (world frame, m/s; None when not known)."""
         q = np.asarray(q, dtype=float)
+        if world is not None:
+            self._world.append((stamp, np.array(world, dtype=float)))
+            while len(self._world) > 1 and stamp - self._world[1][0] >= self._steady_s:
+                self._world.popleft()
         self.velocity = None if velocity is None else np.array(velocity, dtype=float)
         if self._q is not None and self._t is not None and stamp > self._t:
             rate = (q - self._q) / (stamp - self._t)
@@ -191,6 +200,7 @@ class TargetSelector:
         """Forget where the person is relative to the sensor (learnt afresh from the next
         track seen as them)."""
         self._q, self._t, self._v, self.steady, self._slid_since = None, None, np.zeros(2), None, None
+        self._world.clear()
 
     def coasting(self, stamp: float, last_update: float) -> bool:
         """Whether a track last updated at ``last_update`` (s) has coasted ``coast_s`` by
@@ -251,6 +261,19 @@ class TargetSelector:
         """Whether a track that was at ``place_then`` (sensor frame then, m) ``trail_s`` ago
         came from farther than ``reacquire_m`` from where the person has been lately."""
         return self.steady is not None and float(np.hypot(*(np.asarray(place_then) - self.steady))) > self._reacquire_m
+
+    def only_the_sensor_moved(self, stamp: float, world: np.ndarray, other_since: float) -> bool:
+        """Whether a target track found slid (:meth:`slid`) at ``stamp`` (s) only moved
+        relative to the sensor: it has stood within half of ``slide_m`` of where it is now,
+        ``world`` (world frame, m), for the last ``steady_s``, and the other track at the
+        person's averaged place has been tracked since ``other_since`` (s), ``steady_s`` or
+        more before. A robot closing in on someone who stopped moves them off their average
+        in the sensor frame, and a walker keeping pace beside the robot stays on it. A track
+        begun there since is more often the person, walked off while their old track stayed
+        on something where they stood: that is still a slide."""
+        if stamp - other_since < self._steady_s or not self._world or stamp - self._world[0][0] < self._steady_s:
+            return False
+        return all(float(np.hypot(*(w - world))) <= 0.5 * self.slide_m for _, w in self._world)
 
     def slid(self, q: np.ndarray) -> bool:
         """Whether the target track at ``q`` (sensor frame, m) is far from where the person has been lately."""

@@ -1198,15 +1198,17 @@ class PeopleTracker:
                 why = "out of reach"
             if t is not None and t.reported and t.updated_now and sel.slid(q):
                 # moved off where the person has been while another track is there: it slid onto a passer-by,
-                # unless that one has just come there from elsewhere (a passer-by where the person was)
+                # unless that one has just come there from elsewhere (a passer-by where the person was),
+                # or only the sensor moved (the target stood still in the world: the robot closed in)
                 now = [u for u in self._tracks if u is not t and u.updated_now]
                 there = sel.only_one_near(stamp, here(now), steady=True)
-                if there is not None and not sel.came_from_elsewhere(
-                        self._trails[next(u for u in now if u.track_id == there)][0][1]):
+                other = next((u for u in now if u.track_id == there), None)
+                if (other is not None and not sel.came_from_elsewhere(self._trails[other][0][1])
+                        and not sel.only_the_sensor_moved(stamp, t.position, other.born)):
                     t = self._retire(t)
                     sel.lost(stamp, "slid onto someone")
             if t is not None and t.reported and t.updated_now:
-                sel.seen(stamp, q, t.velocity)
+                sel.seen(stamp, q, t.velocity, t.position)
             elif t is None or not t.reported:
                 sel.lost(stamp, why)
             elif sel.coasting(stamp, t.last_update):
@@ -1230,7 +1232,7 @@ class PeopleTracker:
                                               if u.track_id in reported})
         t = next(u for u in self._tracks if u.track_id == target) if target in reported else None  # ids are unique
         if t is not None and sel.expected(stamp) is None:
-            sel.seen(stamp, reported[target], t.velocity)
+            sel.seen(stamp, reported[target], t.velocity, t.position)
         if t is not None and sel.coasting(stamp, t.last_update):
             return None  # coasting: where the person is now is a guess; reported lost, not marked
         return target
