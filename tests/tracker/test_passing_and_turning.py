@@ -809,6 +809,17 @@ def test_a_track_that_was_where_the_person_stood_still_takes_the_target_off_a_sl
     assert tracker._tracks[0].track_id != pid  # the slid track goes on under a new id
 
 
+def _followed_2m_ahead() -> tuple[PeopleTracker, object]:
+    """A tracker following (``auto``) one confirmed track born 2 m straight ahead of a laser
+    at the world origin at 0 s, and that track."""
+    tracker = PeopleTracker.from_config(load_config(), follow="auto")
+    tracker._spawn([PersonCandidate(2.0, 0.0, 0.05, "pair")], 0.0)
+    (person,) = tracker._tracks
+    person.confirmed, person.existence.l_dyn = True, 5.0
+    assert tracker.selector.choose({person.track_id: np.array([2.0, 0.0])}) == person.track_id
+    return tracker, person
+
+
 def test_a_target_back_from_coasting_on_a_passer_by_does_not_drag_the_persons_place_with_it():
     """Development run indoors (long_cw laser, seed 4, 555 s): the person, 2 m ahead, was
     hidden for 0.8 s; their track's next update came from a passer-by 1 m to the side. The
@@ -817,12 +828,8 @@ def test_a_target_back_from_coasting_on_a_passer_by_does_not_drag_the_persons_pl
     longer found the target off their place, and the target stayed on the passer-by for 41 s.
     A target back from coasting somewhere off the person's place is not learnt into it for
     ``steady_s``."""
-    tracker = PeopleTracker.from_config(load_config(), follow="auto")
+    tracker, person = _followed_2m_ahead()
     sel = tracker.selector
-    tracker._spawn([PersonCandidate(2.0, 0.0, 0.05, "pair")], 0.0)
-    (person,) = tracker._tracks
-    person.confirmed, person.existence.l_dyn = True, 5.0
-    assert sel.choose({person.track_id: np.array([2.0, 0.0])}) == person.track_id
     pid = person.track_id
     for k in range(1, 21):  # 2 s on the person
         person.predict(0.1 * k)
@@ -934,12 +941,7 @@ def _closing_in(walker_age_s: float) -> tuple[PeopleTracker, int]:
     at 0.8 m/s from 2 s on, while another track keeps 1.9 m ahead and 0.6 m to the side of
     the laser (a walker beside the robot, begun ``walker_age_s`` before the drive). Returns
     the tracker when the laser has come within 0.9 m of the person and the person's id."""
-    tracker = PeopleTracker.from_config(load_config(), follow="auto")
-    sel = tracker.selector
-    tracker._spawn([PersonCandidate(2.0, 0.0, 0.05, "pair")], 0.0)
-    (person,) = tracker._tracks
-    person.confirmed, person.existence.l_dyn = True, 5.0
-    assert sel.choose({person.track_id: np.array([2.0, 0.0])}) == person.track_id
+    tracker, person = _followed_2m_ahead()
     pid, walker = person.track_id, None
     for k in range(1, 35):
         stamp = 0.1 * k
