@@ -97,7 +97,19 @@ class TargetSelector:
         more nearly straight ahead than the target by at least ``settle_margin_m`` metres (any
         one in the lane, once the target is beside or behind the sensor) takes the target,
         unless their offset from the axis changed by more than that over the last ``trail_s``
-        (or since they began): someone crossing the robot's way passes its axis.
+        (or since they began): someone crossing the robot's way passes its axis. A target
+        lost while the lock settles is chosen afresh, as at the first lock: the person
+        to follow is the one in the robot's way, and the re-lock (which waits ``relock_s``,
+        and then chooses none of several) is for a person it has learnt.
+    approach_mps : float
+        ``auto``, until the first lock has settled (``settle_s``): a track in the lane
+        that came nearer along the sensor's axis faster than this (m/s) over the last
+        ``trail_s`` (tracked for at least half of it) is someone the robot overtakes or who
+        comes towards it, not the person it follows: it is never locked onto, and a target
+        found so gives way to the one in the robot's way. The speed is relative to the
+        sensor, so a robot that drives up to someone standing counts too; a robot following
+        someone keeps its distance, and someone crossing its way keeps their distance along
+        its axis. ``math.inf``: no such test.
         The choice is still being made: whoever is reported first is not always the one in the
         robot's way. A passer-by close in front is seen moving at once, while the person to
         follow, walking away from the laser in their own shadow, may be confirmed a few tenths
@@ -110,7 +122,8 @@ class TargetSelector:
                  slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35,
                  lane_m: float = 0.75, same_velocity_mps: float = 0.2, other_velocity_mps: float = 1.2,
                  max_walk_change_mps: float | None = 1.0, sensor_velocity_s: float = 0.5,
-                 trail_s: float = 1.0, settle_s: float = 2.0, settle_margin_m: float = 0.2) -> None:
+                 trail_s: float = 1.0, settle_s: float = 2.0, settle_margin_m: float = 0.2,
+                 approach_mps: float = 0.5) -> None:
         self.mode = mode
         self.target: int | None = None if mode in (None, "auto") else int(mode)
         self._reacquire_s, self._reacquire_m, self._walk = reacquire_s, reacquire_m, walk_mps
@@ -119,6 +132,8 @@ class TargetSelector:
         self.relock_s, self._same_person_m, self._lane_m = relock_s, same_person_m, lane_m
         self.trail_s = trail_s
         self.settle_s, self.settle_margin_m = settle_s, settle_margin_m
+        self.approach_mps = approach_mps
+        self._passing: set[int] = set()  # ids seen closing in on the sensor while the first lock settled
         self._locked_at: float | None = None  # when the first lock was made (s)
         self.steady: np.ndarray | None = None  # the person's place relative to the sensor, averaged (m)
         self._world: deque = deque()  # (stamp s, place m): where the target's track was in the world frame, lately
@@ -373,29 +388,42 @@ class TargetSelector:
             return None
         return ahead[0]
 
+    def choosing(self, stamp: float) -> bool:
+        """Whether ``auto`` is still choosing whom to follow at ``stamp`` (s): no lock yet,
+        or the first lock is settling (``settle_s``)."""
+        return self.mode == "auto" and (self.target is None or (
+            self._locked_at is not None and stamp - self._locked_at <= self.settle_s))
+
     def choose(self, reported: dict[int, np.ndarray], stamp: float | None = None,
-               then: dict[int, np.ndarray] | None = None) -> int | None:
+               then: dict[int, np.ndarray] | None = None,
+               closing: dict[int, float] | None = None) -> int | None:
         """The target id now, given reported tracks (id → sensor-frame place, m) at ``stamp``
         (s; without it the first lock is never revised, see ``settle_s``) and, when known,
         where they were ``trail_s`` ago or where they began (id → place in the sensor frame
-        then, m)."""
+        then, m) and how fast their range from the sensor shrank over that time (id → m/s,
+        for the tracks followed long enough; see ``approach_mps``)."""
         if self.mode != "auto":
             return self.target
         settling = (self.target is not None and stamp is not None
                     and self._locked_at is not None and stamp - self._locked_at <= self.settle_s)
         if self.target is not None and not settling:
             return self.target
-        # following starts: the person to follow stands in the robot's way
+        # following starts: the person to follow stands in the robot's way, and keeps their distance
         aside = {tid: abs(float(reported[tid][1])) for tid in self.in_front(reported)}  # m off the axis
-        lane = [tid for tid, off in aside.items() if off <= self._lane_m]
+        self._passing |= {tid for tid, v in (closing or {}).items()
+                          if v > self.approach_mps and aside.get(tid, math.inf) <= self._lane_m}
+        lane = [tid for tid, off in aside.items() if off <= self._lane_m and tid not in self._passing]
         best = min(lane, key=lambda tid: (aside[tid], tid)) if lane else None
         if settling:  # someone clearly more in the robot's way than the target takes it
             # (a target gone beside or behind the sensor is in nobody's way) ...
-            # ... and stays there (someone crossing the robot's way passes its axis)
-            if (best is None or best == self.target or self.target not in reported
-                    or aside[best] + self.settle_margin_m > self._off_axis(reported[self.target])
-                    or (then and best in then
-                        and abs(float(reported[best][1] - then[best][1])) > self.settle_margin_m)):
+            # ... and stays there (someone crossing the robot's way passes its axis);
+            # a target lost, or found passing by, is chosen afresh
+            crossing = bool(then and best in then
+                            and abs(float(reported[best][1] - then[best][1])) > self.settle_margin_m)
+            afresh = self.lost_since is not None or self.target in self._passing
+            if (best is None or best == self.target or crossing
+                    or (not afresh and (self.target not in reported or aside[best] + self.settle_margin_m
+                                        > self._off_axis(reported[self.target])))):
                 return self.target
             self._forget_place()  # learnt afresh
             self.velocity, self.lost_since = None, None

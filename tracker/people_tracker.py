@@ -1228,8 +1228,14 @@ class PeopleTracker:
                     new = next(u for u in self._tracks if u.track_id == new_id)
                     new.track_id = sel.target  # the person keeps their id
         reported = here(u for u in self._tracks if u.reported and u not in unreported)
+        closing = {}  # while choosing whom to follow: how fast each reported track comes nearer along the sensor's axis (m/s)
+        if sel.choosing(stamp):
+            for u in self._tracks:
+                (s0, q0), (s1, q1) = self._trails[u][0], self._trails[u][-1]
+                if u.track_id in reported and s1 - s0 >= 0.5 * sel.trail_s:
+                    closing[u.track_id] = float(q0[0] - q1[0]) / (s1 - s0)
         target = sel.choose(reported, stamp, {u.track_id: self._trails[u][0][1] for u in self._tracks
-                                              if u.track_id in reported})
+                                              if u.track_id in reported}, closing)
         t = next(u for u in self._tracks if u.track_id == target) if target in reported else None  # ids are unique
         if t is not None and sel.expected(stamp) is None:
             sel.seen(stamp, reported[target], t.velocity, t.position)
