@@ -388,11 +388,16 @@ class TargetSelector:
             return None
         return ahead[0]
 
+    def _settling(self, stamp: float | None) -> bool:
+        """Whether the first lock is still settling at ``stamp`` (s; never without one): made
+        no more than ``settle_s`` before."""
+        return (self.target is not None and stamp is not None
+                and self._locked_at is not None and stamp - self._locked_at <= self.settle_s)
+
     def choosing(self, stamp: float) -> bool:
         """Whether ``auto`` is still choosing whom to follow at ``stamp`` (s): no lock yet,
         or the first lock is settling (``settle_s``)."""
-        return self.mode == "auto" and (self.target is None or (
-            self._locked_at is not None and stamp - self._locked_at <= self.settle_s))
+        return self.mode == "auto" and (self.target is None or self._settling(stamp))
 
     def choose(self, reported: dict[int, np.ndarray], stamp: float | None = None,
                then: dict[int, np.ndarray] | None = None,
@@ -400,12 +405,11 @@ class TargetSelector:
         """The target id now, given reported tracks (id → sensor-frame place, m) at ``stamp``
         (s; without it the first lock is never revised, see ``settle_s``) and, when known,
         where they were ``trail_s`` ago or where they began (id → place in the sensor frame
-        then, m) and how fast their range from the sensor shrank over that time (id → m/s,
-        for the tracks followed long enough; see ``approach_mps``)."""
+        then, m) and how fast they came nearer along the sensor's axis over that time (id →
+        m/s, for the tracks followed long enough; see ``approach_mps``)."""
         if self.mode != "auto":
             return self.target
-        settling = (self.target is not None and stamp is not None
-                    and self._locked_at is not None and stamp - self._locked_at <= self.settle_s)
+        settling = self._settling(stamp)
         if self.target is not None and not settling:
             return self.target
         # following starts: the person to follow stands in the robot's way, and keeps their distance
