@@ -504,6 +504,7 @@ class PeopleTracker:
                 self._next_id += 1
             t = TrackState(track_id, float(z[0]), float(z[1]), R, scan.stamp, self.track_params, ex, standing=True)
             t.confirmed, t.moved, t.place = True, True, PlaceMemory.UNKNOWN
+            t.retaken_beside = None if track_id == e.track_id else e.track_id
             t.last_moving_update = t.last_update - self.track_params.still_after_s  # standing still
             self._tracks.append(t)
             used.add(track_id)
@@ -1106,17 +1107,30 @@ class PeopleTracker:
         :meth:`_hand_over`), or the standing one takes the step and the walking one goes as
         the same person twice; reported meanwhile, it showed the person under another id for
         a few scans."""
-        standing = [t for t in self._tracks if t.reported and t.still and t.existence.walked_or_arrived]
-        if not standing:
-            return []
         r = self.assoc.recover_radius_m
-        return [u for t in standing for u in self._born_beside(t, self._tracks, stamp)
-                if u.track_id > t.track_id and not u.still and np.hypot(*(u.position - t.position)) <= r]
+        out = self._left_behind(stamp)
+        standing = [t for t in self._tracks if t.reported and t.still and t.existence.walked_or_arrived]
+        return out + [u for t in standing for u in self._born_beside(t, self._tracks, stamp)
+                      if u.track_id > t.track_id and not u.still and np.hypot(*(u.position - t.position)) <= r]
+
+    def _left_behind(self, stamp: float) -> list[TrackState]:
+        """Tracks taken up again where someone stood (:meth:`_reacquire_standing`) under a new
+        id, because that person's id lives on a walking track, while that track is still within
+        ``association.recover_radius_m`` of the place, for ``SET_OFF_S`` at most: not reported
+        yet. Someone standing who sets off leaves their trailing leg on the spot for a step, and
+        it is taken up as them again while their track walks on; a person whose track went off
+        with a passer-by is reported once the passer-by is beyond reach."""
+        walking = {t.track_id: t for t in self._tracks if t.confirmed and not t.still}
+        r = self.assoc.recover_radius_m
+        return [u for u in self._tracks if u.retaken_beside in walking and stamp - u.born <= SET_OFF_S
+                and np.hypot(*(walking[u.retaken_beside].position - u.origin)) <= r]
 
     def _hand_over(self, t: TrackState, living: list[TrackState], stamp: float) -> bool:
         """A person who stood still and set off: their place empties (the standing track
-        dies) while a new track starts beside it, which takes the standing one's id."""
-        if not (t.confirmed and t.existence.walked_or_arrived and t.still):
+        dies) while a new track starts beside it, which takes the standing one's id. So too
+        when the standing track took a first step (set off within ``SET_OFF_S``) but the new
+        one took the steps after it, and the old one dies behind them."""
+        if not (t.confirmed and t.existence.walked_or_arrived and (t.still or stamp - t.set_off_at <= SET_OFF_S)):
             return False
         young = [u for u in self._born_beside(t, living, stamp) if u.track_id > t.track_id]
         if not young:

@@ -113,6 +113,7 @@ class TrackState:
         self.born = stamp
         self.last_update = stamp
         self.last_moving_update = stamp
+        self.set_off_at = -math.inf  # when a moving candidate last updated it while it stood still, s
         self.brisk_at = -math.inf  # when the tracker last saw it at association.stopping_speed_mps or faster, s
         self.velocity_since = stamp  # when its velocity was last forgotten (born, stood, turned), s
         self.moving_position = np.array([x, y])  # where the last moving candidate put it, m
@@ -128,6 +129,8 @@ class TrackState:
         self.moved = not standing  # has a moving candidate ever updated it
         self.update_kind: str | None = "static" if standing else "moving"  # how this scan updated it
         self.place: str | None = None  # PlaceMemory's verdict on where it stands still (None: not judged)
+        # taken up where someone stood while their id was alive on another track: that id (None: not so)
+        self.retaken_beside: int | None = None
 
     @property
     def position(self) -> np.ndarray:
@@ -199,6 +202,7 @@ class TrackState:
     def update(self, z: np.ndarray, R: np.ndarray, moving: bool) -> None:
         """Correct with a candidate position ``z`` (m) of covariance ``R`` (m²)."""
         # y = z - H x ; S = H P Hᵀ + R ; K = P Hᵀ S⁻¹ ; x = x + K y ; P = (I - K H) P (I - K H)ᵀ + K R Kᵀ
+        stood = self.still  # before this update: a walker unseen for a while has not stood
         self.kf.x, self.kf.P = position_update(self.kf.x, self.kf.P, np.asarray(z, dtype=float),
                                                np.asarray(R, dtype=float))
         self.last_update = self.stamp
@@ -206,6 +210,8 @@ class TrackState:
         self.hidden_position = None
         self.seen_evidence = self.existence.l_dyn
         if moving:
+            if stood:
+                self.set_off_at = self.stamp
             self.moved = True
             self.last_moving_update = self.stamp
             self.moving_position = self.position.copy()

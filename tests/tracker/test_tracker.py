@@ -735,6 +735,52 @@ def test_a_first_step_found_farther_on_after_an_unseen_start_still_takes_the_id(
     assert tracker._born_beside(stander, tracker._tracks, 1.0) == []
 
 
+def test_a_standing_track_that_took_the_first_step_hands_its_id_over_when_it_dies_behind_them():
+    """Traced in the waiting room (seed 23, person 10 at 366 s): someone who had stood for
+    minutes set off; their standing track took the first step (a moving update) and then
+    lagged, while a new track took the steps after it. The old track died behind them, no
+    longer standing still, so its id was not handed over and the person walked out under a
+    new one. A track that set off within ``SET_OFF_S`` hands its id over as a standing one does;
+    one that never stood, or set off long ago, does not."""
+    from people_tracker.tracker.people_tracker import SET_OFF_S
+    tracker = PeopleTracker.from_config(load_config())
+    stander, walker = _stander_and_first_step(tracker)
+    stander.update(np.array([5.35, 1.31]), np.eye(2) * 0.01, moving=True)  # the first step, at 1.0 s
+    assert stander.set_off_at == 1.0 and not stander.still
+    walker.kf.x[0] = 5.85 + 0.3
+    assert tracker._hand_over(stander, [walker], 1.3)
+    assert walker.track_id == stander.track_id == 1
+    walker.track_id = 2
+    assert not tracker._hand_over(stander, [walker], 1.0 + SET_OFF_S + 0.1)  # set off long ago
+    walking, _ = new_track(x=5.25, y=1.31, params=tracker.track_params)  # walked in, never stood
+    walking.confirmed, walking.existence.walked_or_arrived = True, True
+    walking.stamp = 1.0
+    walking.update(np.array([5.35, 1.31]), np.eye(2) * 0.01, moving=True)
+    assert walking.set_off_at == -np.inf
+    assert not tracker._hand_over(walking, [walker], 1.3)
+
+
+def test_someone_taken_up_again_where_they_stood_is_not_reported_while_their_track_walks_off():
+    """Traced in the waiting room (seed 23, person 8 at 342 s): someone who had stood set off;
+    their track walked with them, and their trailing leg, still on the spot for a step, was
+    taken up again where they had stood (under a new id, theirs being alive) and reported
+    for 0.4 s nearer them than their own track. Such a track is not reported while the
+    track with their id is within ``recover_radius_m`` of the place; once that track is
+    beyond reach (it went off with a passer-by) it is."""
+    tracker = PeopleTracker.from_config(load_config())
+    stander, walker = _stander_and_first_step(tracker)
+    stander.retaken_beside = 2  # taken up again where the walker (id 2) had stood
+    stander.origin = np.array([5.55, 1.31])
+    stander.born = 0.9
+    walker.kf.x[0] = 5.9  # 0.35 m on: within reach
+    assert stander in tracker._first_steps(1.0)
+    walker.kf.x[0] = 5.55 + tracker.assoc.recover_radius_m + 0.1  # beyond reach
+    assert stander not in tracker._first_steps(1.0)
+    walker.kf.x[0] = 5.9
+    stander.retaken_beside = None
+    assert stander not in tracker._first_steps(1.0)
+
+
 def test_a_walkers_leg_never_pairs_away_from_them_with_a_leg_nobody_owns():
     p = PairingParams()  # a stride 0.8 m: half a stride 0.4 m
     from people_tracker.tracker.pairing import owners
