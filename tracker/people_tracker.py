@@ -1106,12 +1106,13 @@ class PeopleTracker:
         seen empty, or its track dies) and the walking one takes its id (:meth:`_set_off`,
         :meth:`_hand_over`), or the standing one takes the step and the walking one goes as
         the same person twice; reported meanwhile, it showed the person under another id for
-        a few scans."""
-        r = self.assoc.recover_radius_m
-        out = self._left_behind(stamp)
+        a few scans. Also the tracks of :meth:`_left_behind`: the reverse case, someone's
+        trailing leg taken up again where they stood while their own track walks on."""
         standing = [t for t in self._tracks if t.reported and t.still and t.existence.walked_or_arrived]
-        return out + [u for t in standing for u in self._born_beside(t, self._tracks, stamp)
-                      if u.track_id > t.track_id and not u.still and np.hypot(*(u.position - t.position)) <= r]
+        r = self.assoc.recover_radius_m
+        return self._left_behind(stamp) + [
+            u for t in standing for u in self._born_beside(t, self._tracks, stamp)
+            if u.track_id > t.track_id and not u.still and np.hypot(*(u.position - t.position)) <= r]
 
     def _left_behind(self, stamp: float) -> list[TrackState]:
         """Tracks taken up again where someone stood (:meth:`_reacquire_standing`) under a new
