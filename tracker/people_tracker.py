@@ -161,6 +161,22 @@ class StoodPlace:
                 self.xy = self.along.mean(axis=0)
 
 
+@dataclass(eq=False)
+class VanishedWalker:
+    """A confirmed walker whose track ended where the scan did not see their place empty:
+    hidden, or glimpsed on too few readings to be seen moving (behind furniture)."""
+
+    track_id: int
+    xy: np.ndarray  # its last predicted place (world frame, m) ...
+    velocity: np.ndarray  # ... its velocity (world frame, m/s) ...
+    stamp: float  # ... at this time, s
+    seen: float  # its last update, s
+
+    def at(self, stamp: float) -> np.ndarray:
+        """Where they would be at ``stamp`` walking on as they were (world frame, m)."""
+        return self.xy + self.velocity * (stamp - self.stamp)
+
+
 # m/s: a track this fast passing close by someone standing is a passer-by, not them twice (a
 # walker's estimated speed lags: one setting off or slowing beside them reads 0.4-0.5 m/s at 0.7)
 PASSING_MPS = 0.3
@@ -199,6 +215,7 @@ class PeopleTracker:
         self.existence = existence or ExistenceParams()
         self.places = PlaceMemory(self.existence.place_keyframe_s, self.existence.place_memory_s)
         self._stood: list[StoodPlace] = []
+        self._vanished: list[VanishedWalker] = []  # walkers whose tracks ended unseen, the last SET_OFF_S
         self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
         self._leg_scores = np.zeros(0)  # ... and their leg probabilities
         self._stopping: dict[int, np.ndarray] = {}  # track index -> the candidates it may not take this scan
@@ -207,8 +224,9 @@ class PeopleTracker:
         self._tracks: list[TrackState] = []
         # each track's places in the sensor frame over the selector's trail_s: (stamp s, place m)
         self._trails: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-        # pairs of walking tracks closer than tracks.min_person_separation_m: since when (s)
-        self._close_since: dict[tuple[TrackState, TrackState], float] = {}
+        # pairs of walking tracks within a stride of each other: (since when s, the integral of
+        # their distance over that time m·s, the last stamp s)
+        self._close_since: dict[tuple[TrackState, TrackState], tuple[float, float, float]] = {}
         self._next_id = 1
         self.last: StepResult | None = None
         self.bad_poses = 0  # poses given with a scan that were not finite (the scan was used without)
@@ -282,6 +300,7 @@ class PeopleTracker:
         self._support(scan, world, matched_t)  # 7. static support for the rest
         self._weigh(scan, world)  # 7b. evidence of existence
         self._walked_off_unseen(scan.stamp)  # 7c. a walker confirmed where someone stood hidden: them
+        self._walked_on_unseen(scan.stamp)  # 7d. ... or on the path of a walker whose track ended unseen
         self.places.add(scan, world)
         self._remember_standing(scan, world)
         self._reacquire_standing(scan, world)
@@ -454,6 +473,36 @@ class PeopleTracker:
             e = self._stood.pop(k)
             u.track_id = e.track_id
             alive.add(e.track_id)
+
+    def _walked_on_unseen(self, stamp: float) -> None:
+        """A walker whose track ended while their place was not seen empty (hidden, or
+        glimpsed behind furniture on a reading or two: too little to be seen moving, so the
+        track lost its evidence and ended), found walking on: a walking track confirmed this
+        scan, born within ``SET_OFF_S`` of the old track's last update, heading the same way
+        (within 90°), whose first place lies within ``association.recover_radius_m`` of where
+        the old one would have been by then, walking on as it was, takes its id before it is
+        first reported. Of several, the nearest; none when a confirmed track lies nearer
+        where the walking one began (it explains it better), or the walking one has taken
+        an id already (:meth:`_hand_over`, :meth:`_walked_off_unseen`)."""
+        self._vanished = [e for e in self._vanished if stamp - e.seen <= SET_OFF_S]
+        if not self._vanished:
+            return
+        alive = {t.track_id for t in self._tracks}
+        r = self.assoc.recover_radius_m
+        for u in self._tracks:
+            if u.confirmed_at != stamp or u.born_standing or u.track_id != u.born_id:
+                continue
+            near = [(float(np.hypot(*(e.at(u.born) - u.origin))), k) for k, e in enumerate(self._vanished)
+                    if e.track_id not in alive and u.born - e.seen <= SET_OFF_S and e.velocity @ u.velocity > 0]
+            d, k = min(near, default=(np.inf, -1))
+            if d > r or any(t is not u and t.confirmed and np.hypot(*(t.position - u.origin)) <= d
+                            for t in self._tracks):
+                continue
+            e = self._vanished.pop(k)
+            u.track_id = e.track_id
+            alive.add(e.track_id)
+            # they walked on: not stopped where their track ended (_remember_ended_out_of_sight)
+            self._stood = [g for g in self._stood if not (g.guess and g.track_id == e.track_id)]
 
     def _reacquire_standing(self, scan: Scan, world: Pose2D) -> None:
         """A person-sized object where someone stood, and no track there: that person, seen
@@ -1046,10 +1095,14 @@ class PeopleTracker:
         ``tracks.still_after_s``, at ``PASSING_MPS`` or faster; passing in front of or behind
         the standing person hides one of them for a moment) is someone passing close by, and
         stays.
-        Two walking tracks that close for ``tracks.same_person_after_s`` are one person twice
-        (a track on each leg, or one that slid onto them from a passer-by): the one whose
-        place is less certain (the larger trace of its position covariance) goes, unless it
-        is the followed person's."""
+        Two walking tracks that close on average over ``tracks.same_person_after_s``, never a
+        stride (``pairing.max_leg_separation_m``) apart meanwhile, are one person twice (a
+        track on each leg, whose distance swings with the gait from a few centimetres to
+        half a metre, or one that slid onto them from a passer-by; two people walking
+        together keep their torsos farther apart than that all the time): the one confirmed
+        later goes (the id they were reported under stays with them; of two confirmed at once,
+        the one whose place is less certain, the larger trace of its position covariance),
+        unless it is the followed person's."""
         sep, after_s = self.track_params.min_person_separation_m, self.track_params.same_person_after_s
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
         close_since, self._close_since = self._close_since, {}
@@ -1058,7 +1111,7 @@ class PeopleTracker:
         xy = np.array([self._tracks[i].position for i in idx])
         d = pairwise_distances(xy, xy)
         out = set()
-        rows, cols = np.nonzero(d < sep)
+        rows, cols = np.nonzero(d < max(sep, self.pairing.max_leg_separation_m))
         upper = rows < cols  # each pair once, in np.triu's (row-major) order
         target = self.selector.target if self.selector is not None else None
         for a, b in zip(rows[upper].tolist(), cols[upper].tolist()):
@@ -1068,11 +1121,15 @@ class PeopleTracker:
             if not (ta.still or tb.still):  # two walking: one person twice once they stay this close
                 if after_s <= 0:
                     continue
-                since = self._close_since[(ta, tb)] = close_since.get((ta, tb), stamp)
-                if stamp - since >= after_s:
-                    goes, stays = (idx[a], idx[b]) if np.trace(ta.position_cov) > np.trace(tb.position_cov) \
-                        else (idx[b], idx[a])
+                since, area, last = close_since.get((ta, tb), (stamp, 0.0, stamp))
+                area += float(d[a, b]) * (stamp - last)
+                self._close_since[(ta, tb)] = (since, area, stamp)
+                if stamp - since >= after_s and area < sep * (stamp - since):
+                    goes, stays = (idx[a], idx[b]) if (ta.confirmed_at, np.trace(ta.position_cov)) > \
+                        (tb.confirmed_at, np.trace(tb.position_cov)) else (idx[b], idx[a])
                     out.add(stays if self._tracks[goes].track_id == target else goes)
+                continue
+            if d[a, b] >= sep:
                 continue
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])
@@ -1161,7 +1218,10 @@ class PeopleTracker:
         for t in dying:
             if t.furniture() and t.existence.probability >= self.existence.delete:
                 self.standing.furniture(t.position)
-            self._hand_over(t, keep, stamp)
+            if not self._hand_over(t, keep, stamp) and t.confirmed and t.moved and not t.still \
+                    and t.visibility != SEEN_THROUGH:
+                self._vanished.append(VanishedWalker(t.track_id, t.position.copy(), t.velocity.copy(), stamp,
+                                                     t.last_update))
             self._remember_ended_out_of_sight(t, stamp)
         self._tracks = keep
 

@@ -791,6 +791,50 @@ def test_a_walker_takes_a_remembered_id_only_as_the_first_steps_from_where_they_
     assert case(inherited=True) == (3, 1)
 
 
+def test_a_walker_whose_track_ended_unseen_gets_their_id_back_walking_on():
+    """Traced in the waiting room (development seeds 67 and 72, about a third of the id
+    changes over seeds 61-84): a walker just confirmed went on behind chairs and tables,
+    glimpsed on two readings, too few to be seen moving; their place was in view and occupied,
+    so each scan counted against a walker that should be seen moving, and the track ended
+    within a second, its prediction still within 0.1 m of them. A new track took them up
+    1-2 s later, under a new id. A walking track confirmed within SET_OFF_S of the old one's
+    last update, heading the same way, whose first place lies within
+    association.recover_radius_m of where the old one would be by then, takes its id."""
+    from people_tracker.detection.free_space import OCCUPIED, SEEN_THROUGH
+    from people_tracker.tracker.people_tracker import SET_OFF_S
+
+    def case(born_at=(4.0, 0.1), born_s=101.5, heading=1.0, ended=OCCUPIED, someone_at=None):
+        tracker = PeopleTracker.from_config(load_config())
+        old = _two_tracks()._tracks[0]  # a confirmed walking track (born moving) ...
+        old.track_id, old.visibility = 7, ended
+        old.kf.x[:] = [2.0, 1.0, 0.0, 0.0]  # ... at (2, 0), walking along +x at 1 m/s
+        old.stamp = old.last_update = old.last_moving_update = old.existence.stamp = 100.0
+        old.existence.l_dyn = old.existence.l_delete - 1.0  # ended now
+        tracker._tracks = [old]
+        tracker._delete(100.0)
+        assert tracker._tracks == []
+        tracker._spawn([PersonCandidate(*born_at, 0.05, "leg")], born_s)
+        u = tracker._tracks[-1]
+        u.kf.x[1] = heading
+        if someone_at is not None:  # someone tracked, nearer where the walker began
+            tracker._spawn([PersonCandidate(9.0, 9.0, 0.05, "pair")], born_s)
+            tracker._tracks[-1].kf.x[::2] = someone_at
+            tracker._tracks[-1].confirmed = True
+        u.confirmed = True  # confirmed this scan
+        stamp = born_s + 0.3
+        u.confirmed_at = stamp
+        tracker._walked_on_unseen(stamp)
+        return u.track_id
+
+    assert case() == 7  # 0.1 m from where they would be, 1.5 s on
+    assert case(ended=SEEN_THROUGH) != 7  # their place was seen empty: gone
+    assert case(heading=-1.0) != 7  # walking the other way: someone else
+    assert case(born_at=(4.0, 1.0)) != 7  # farther than association.recover_radius_m
+    assert case(born_at=(2.0 + SET_OFF_S + 0.2, 0.0), born_s=100.0 + SET_OFF_S + 0.2) != 7  # too late
+    assert case(someone_at=(4.0, 0.05)) != 7  # the tracked one is nearer
+    assert case(someone_at=(6.0, 0.0)) == 7
+
+
 def test_the_persons_id_given_to_another_track_leaves_their_old_unreported_one():
     """Found in a held-out following run (indoors, laser long_cw, seed 15): the target's track
     went unreported (no update for 2 s) but lived on, and the re-lock gave the person's id to
