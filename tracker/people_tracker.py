@@ -1099,10 +1099,9 @@ class PeopleTracker:
         stride (``pairing.max_leg_separation_m``) apart meanwhile, are one person twice (a
         track on each leg, whose distance swings with the gait from a few centimetres to
         half a metre, or one that slid onto them from a passer-by; two people walking
-        together keep their torsos farther apart than that all the time): the one confirmed
-        later goes (the id they were reported under stays with them; of two confirmed at once,
-        the one whose place is less certain, the larger trace of its position covariance),
-        unless it is the followed person's."""
+        together keep their torsos farther apart than that all the time): the one whose
+        place is less certain (the larger trace of its position covariance) goes, unless it
+        is the followed person's."""
         sep, after_s = self.track_params.min_person_separation_m, self.track_params.same_person_after_s
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
         close_since, self._close_since = self._close_since, {}
@@ -1125,8 +1124,8 @@ class PeopleTracker:
                 area += float(d[a, b]) * (stamp - last)
                 self._close_since[(ta, tb)] = (since, area, stamp)
                 if stamp - since >= after_s and area < sep * (stamp - since):
-                    goes, stays = (idx[a], idx[b]) if (ta.confirmed_at, np.trace(ta.position_cov)) > \
-                        (tb.confirmed_at, np.trace(tb.position_cov)) else (idx[b], idx[a])
+                    goes, stays = (idx[a], idx[b]) if np.trace(ta.position_cov) > np.trace(tb.position_cov) \
+                        else (idx[b], idx[a])
                     out.add(stays if self._tracks[goes].track_id == target else goes)
                 continue
             if d[a, b] >= sep:
