@@ -224,9 +224,8 @@ class PeopleTracker:
         self._tracks: list[TrackState] = []
         # each track's places in the sensor frame over the selector's trail_s: (stamp s, place m)
         self._trails: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-        # pairs of walking tracks within a stride of each other: (since when s, the integral of
-        # their distance over that time m·s, the last stamp s)
-        self._close_since: dict[tuple[TrackState, TrackState], tuple[float, float, float]] = {}
+        # pairs of walking tracks closer than tracks.min_person_separation_m: since when (s)
+        self._close_since: dict[tuple[TrackState, TrackState], float] = {}
         self._next_id = 1
         self.last: StepResult | None = None
         self.bad_poses = 0  # poses given with a scan that were not finite (the scan was used without)
@@ -483,9 +482,11 @@ class PeopleTracker:
         the old one would have been by then, walking on as it was, takes its id before it is
         first reported. Of several, the nearest; none when a confirmed track lies nearer
         where the walking one began (it explains it better), or the walking one has taken
-        an id already (:meth:`_hand_over`, :meth:`_walked_off_unseen`)."""
+        an id already (:meth:`_hand_over`, :meth:`_walked_off_unseen`).
+        Not while following someone (``follow``): the selector re-locks on the followed
+        person by its own rules, and the following scenes have not been measured with it."""
         self._vanished = [e for e in self._vanished if stamp - e.seen <= SET_OFF_S]
-        if not self._vanished:
+        if not self._vanished or self.selector is not None:
             return
         alive = {t.track_id for t in self._tracks}
         r = self.assoc.recover_radius_m
@@ -1095,11 +1096,8 @@ class PeopleTracker:
         ``tracks.still_after_s``, at ``PASSING_MPS`` or faster; passing in front of or behind
         the standing person hides one of them for a moment) is someone passing close by, and
         stays.
-        Two walking tracks that close on average over ``tracks.same_person_after_s``, never a
-        stride (``pairing.max_leg_separation_m``) apart meanwhile, are one person twice (a
-        track on each leg, whose distance swings with the gait from a few centimetres to
-        half a metre, or one that slid onto them from a passer-by; two people walking
-        together keep their torsos farther apart than that all the time): the one whose
+        Two walking tracks that close for ``tracks.same_person_after_s`` are one person twice
+        (a track on each leg, or one that slid onto them from a passer-by): the one whose
         place is less certain (the larger trace of its position covariance) goes, unless it
         is the followed person's."""
         sep, after_s = self.track_params.min_person_separation_m, self.track_params.same_person_after_s
@@ -1110,7 +1108,7 @@ class PeopleTracker:
         xy = np.array([self._tracks[i].position for i in idx])
         d = pairwise_distances(xy, xy)
         out = set()
-        rows, cols = np.nonzero(d < max(sep, self.pairing.max_leg_separation_m))
+        rows, cols = np.nonzero(d < sep)
         upper = rows < cols  # each pair once, in np.triu's (row-major) order
         target = self.selector.target if self.selector is not None else None
         for a, b in zip(rows[upper].tolist(), cols[upper].tolist()):
@@ -1120,15 +1118,11 @@ class PeopleTracker:
             if not (ta.still or tb.still):  # two walking: one person twice once they stay this close
                 if after_s <= 0:
                     continue
-                since, area, last = close_since.get((ta, tb), (stamp, 0.0, stamp))
-                area += float(d[a, b]) * (stamp - last)
-                self._close_since[(ta, tb)] = (since, area, stamp)
-                if stamp - since >= after_s and area < sep * (stamp - since):
+                since = self._close_since[(ta, tb)] = close_since.get((ta, tb), stamp)
+                if stamp - since >= after_s:
                     goes, stays = (idx[a], idx[b]) if np.trace(ta.position_cov) > np.trace(tb.position_cov) \
                         else (idx[b], idx[a])
                     out.add(stays if self._tracks[goes].track_id == target else goes)
-                continue
-            if d[a, b] >= sep:
                 continue
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])

@@ -799,12 +799,14 @@ def test_a_walker_whose_track_ended_unseen_gets_their_id_back_walking_on():
     within a second, its prediction still within 0.1 m of them. A new track took them up
     1-2 s later, under a new id. A walking track confirmed within SET_OFF_S of the old one's
     last update, heading the same way, whose first place lies within
-    association.recover_radius_m of where the old one would be by then, takes its id."""
+    association.recover_radius_m of where the old one would be by then, takes its id
+    (not while following someone: measured on the following scenes together with another
+    change, they lost, so they keep what they were measured with)."""
     from people_tracker.detection.free_space import OCCUPIED, SEEN_THROUGH
     from people_tracker.tracker.people_tracker import SET_OFF_S
 
-    def case(born_at=(4.0, 0.1), born_s=101.5, heading=1.0, ended=OCCUPIED, someone_at=None):
-        tracker = PeopleTracker.from_config(load_config())
+    def case(born_at=(4.0, 0.1), born_s=101.5, heading=1.0, ended=OCCUPIED, someone_at=None, follow=None):
+        tracker = PeopleTracker.from_config(load_config(), follow=follow)
         old = _two_tracks()._tracks[0]  # a confirmed walking track (born moving) ...
         old.track_id, old.visibility = 7, ended
         old.kf.x[:] = [2.0, 1.0, 0.0, 0.0]  # ... at (2, 0), walking along +x at 1 m/s
@@ -833,6 +835,7 @@ def test_a_walker_whose_track_ended_unseen_gets_their_id_back_walking_on():
     assert case(born_at=(2.0 + SET_OFF_S + 0.2, 0.0), born_s=100.0 + SET_OFF_S + 0.2) != 7  # too late
     assert case(someone_at=(4.0, 0.05)) != 7  # the tracked one is nearer
     assert case(someone_at=(6.0, 0.0)) == 7
+    assert case(follow="auto") != 7  # not while following (the selector re-locks by its own rules)
 
 
 def test_the_persons_id_given_to_another_track_leaves_their_old_unreported_one():
