@@ -457,21 +457,32 @@ class PeopleTracker:
         of someone standing already (:meth:`_hand_over`): that person's first steps."""
         if not self._stood:
             return
+        self._take_remembered_ids(stamp, self._stood, lambda e, u: np.inf if e.guess or stamp - u.born > SET_OFF_S
+                                  else float(np.hypot(*(e.xy - u.origin))))
+
+    def _take_remembered_ids(self, stamp: float, records: list, distance) -> list:
+        """Each walking track confirmed this scan, not born standing and still under the id it
+        began with, takes the id of the nearest of ``records`` (``distance(record, track)``:
+        from where the track began, m; inf where the record does not apply) that no track
+        holds, within ``association.recover_radius_m``; none when a confirmed track lies
+        nearer where it began (a tracked person's own steps explain it better). The records
+        taken are removed from ``records`` and returned."""
         alive = {t.track_id for t in self._tracks}
         r = self.assoc.recover_radius_m
+        taken = []
         for u in self._tracks:
-            if u.confirmed_at != stamp or u.born_standing or stamp - u.born > SET_OFF_S or u.track_id != u.born_id:
+            if u.confirmed_at != stamp or u.born_standing or u.track_id != u.born_id:
                 continue
-            near = [(float(np.hypot(*(e.xy - u.origin))), k) for k, e in enumerate(self._stood)
-                    if not e.guess and e.track_id not in alive]
+            near = [(distance(e, u), k) for k, e in enumerate(records) if e.track_id not in alive]
             d, k = min(near, default=(np.inf, -1))
-            # a tracked person nearer where it began explains it better (their own first steps)
             if d > r or any(t is not u and t.confirmed and np.hypot(*(t.position - u.origin)) <= d
                             for t in self._tracks):
                 continue
-            e = self._stood.pop(k)
+            e = records.pop(k)
             u.track_id = e.track_id
             alive.add(e.track_id)
+            taken.append(e)
+        return taken
 
     def _walked_on_unseen(self, stamp: float) -> None:
         """A walker whose track ended while their place was not seen empty (hidden, or
@@ -488,22 +499,12 @@ class PeopleTracker:
         self._vanished = [e for e in self._vanished if stamp - e.seen <= SET_OFF_S]
         if not self._vanished or self.selector is not None:
             return
-        alive = {t.track_id for t in self._tracks}
-        r = self.assoc.recover_radius_m
-        for u in self._tracks:
-            if u.confirmed_at != stamp or u.born_standing or u.track_id != u.born_id:
-                continue
-            near = [(float(np.hypot(*(e.at(u.born) - u.origin))), k) for k, e in enumerate(self._vanished)
-                    if e.track_id not in alive and u.born - e.seen <= SET_OFF_S and e.velocity @ u.velocity > 0]
-            d, k = min(near, default=(np.inf, -1))
-            if d > r or any(t is not u and t.confirmed and np.hypot(*(t.position - u.origin)) <= d
-                            for t in self._tracks):
-                continue
-            e = self._vanished.pop(k)
-            u.track_id = e.track_id
-            alive.add(e.track_id)
-            # they walked on: not stopped where their track ended (_remember_ended_out_of_sight)
-            self._stood = [g for g in self._stood if not (g.guess and g.track_id == e.track_id)]
+        taken = self._take_remembered_ids(
+            stamp, self._vanished, lambda e, u: float(np.hypot(*(e.at(u.born) - u.origin)))
+            if u.born - e.seen <= SET_OFF_S and e.velocity @ u.velocity > 0 else np.inf)
+        # they walked on: not stopped where their track ended (_remember_ended_out_of_sight)
+        ids = {e.track_id for e in taken}
+        self._stood = [g for g in self._stood if not (g.guess and g.track_id in ids)]
 
     def _reacquire_standing(self, scan: Scan, world: Pose2D) -> None:
         """A person-sized object where someone stood, and no track there: that person, seen
