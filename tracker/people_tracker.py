@@ -1167,15 +1167,20 @@ class PeopleTracker:
 
     def _left_behind(self, stamp: float) -> list[TrackState]:
         """Tracks taken up again where someone stood (:meth:`_reacquire_standing`) under a new
-        id, because that person's id lives on a walking track, while that track is still within
-        ``association.recover_radius_m`` of the place, for ``SET_OFF_S`` at most: not reported
-        yet. Someone standing who sets off leaves their trailing leg on the spot for a step, and
-        it is taken up as them again while their track walks on; a person whose track went off
-        with a passer-by is reported once the passer-by is beyond reach."""
+        id, because that person's id lives on a walking track, while that track (where it is,
+        or where it was last updated: a track that set off on the swinging leg runs ahead of
+        them) is still within ``association.recover_radius_m`` of the place or of the new
+        track, for ``SET_OFF_S`` at most: not reported yet. Someone standing who sets off
+        leaves their trailing leg on the spot for a step, and it is taken up as them again
+        while their track walks on (and the new track may walk on beside it, until one goes as
+        the same person twice: :meth:`_delete` gives it their id if theirs goes); a person
+        whose track went off with a passer-by is reported once the passer-by is beyond reach."""
         walking = {t.track_id: t for t in self._tracks if t.confirmed and not t.still}
         r = self.assoc.recover_radius_m
-        return [u for u in self._tracks if u.retaken_beside in walking and stamp - u.born <= SET_OFF_S
-                and np.hypot(*(walking[u.retaken_beside].position - u.origin)) <= r]
+        return [u for u in self._tracks if u.retaken_beside in walking and u.retaken_beside != u.track_id
+                and stamp - u.born <= SET_OFF_S and pairwise_distances(np.array([walking[u.retaken_beside].position,
+                                                 walking[u.retaken_beside].seen_position]),
+                                       np.array([u.origin, u.position])).min() <= r]
 
     def _hand_over(self, t: TrackState, living: list[TrackState], stamp: float) -> bool:
         """A person who stood still and set off: their place empties (the standing track
@@ -1209,6 +1214,7 @@ class PeopleTracker:
         duplicates = self._duplicates(stamp)
         dying = [t for i, t in enumerate(self._tracks) if i not in duplicates and (t.dead() or self._set_off(t, stamp))]
         keep = [t for i, t in enumerate(self._tracks) if i not in duplicates and not (t in dying)]
+        self._left_behind_inherit([self._tracks[i] for i in sorted(duplicates)], keep, stamp)
         for t in dying:
             if t.furniture() and t.existence.probability >= self.existence.delete:
                 self.standing.furniture(t.position)
@@ -1218,6 +1224,18 @@ class PeopleTracker:
                                                      t.last_update))
             self._remember_ended_out_of_sight(t, stamp)
         self._tracks = keep
+
+    def _left_behind_inherit(self, goes: list[TrackState], keep: list[TrackState], stamp: float) -> None:
+        """A track of ``goes`` (the same person twice, :meth:`_duplicates`) whose person was
+        taken up again behind them (:meth:`_left_behind`, within ``SET_OFF_S``) by a track of
+        ``keep`` closer to it than ``tracks.min_person_separation_m``: that track walked on
+        with them, and takes their id."""
+        sep = self.track_params.min_person_separation_m
+        for t in goes:
+            heirs = [u for u in keep if u.retaken_beside == t.track_id and stamp - u.born <= SET_OFF_S
+                     and np.hypot(*(u.position - t.position)) < sep]
+            if heirs:
+                heirs[0].track_id, heirs[0].retaken_beside = t.track_id, None
 
     def _remember_ended_out_of_sight(self, t: TrackState, stamp: float) -> None:
         """A confirmed walker whose track ends out of sight (its predicted place was hidden

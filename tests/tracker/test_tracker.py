@@ -765,8 +765,9 @@ def test_someone_taken_up_again_where_they_stood_is_not_reported_while_their_tra
     their track walked with them, and their trailing leg, still on the spot for a step, was
     taken up again where they had stood (under a new id, theirs being alive) and reported
     for 0.4 s nearer them than their own track. Such a track is not reported while the
-    track with their id is within ``recover_radius_m`` of the place; once that track is
-    beyond reach (it went off with a passer-by) it is."""
+    track with their id (where it is, or where it was last updated) is within
+    ``recover_radius_m`` of the place or of the new track; once that track is beyond reach
+    (it went off with a passer-by) it is."""
     tracker = PeopleTracker.from_config(load_config())
     stander, walker = _stander_and_first_step(tracker)
     stander.retaken_beside = 2  # taken up again where the walker (id 2) had stood
@@ -774,11 +775,45 @@ def test_someone_taken_up_again_where_they_stood_is_not_reported_while_their_tra
     stander.born = 0.9
     walker.kf.x[0] = 5.9  # 0.35 m on: within reach
     assert stander in tracker._first_steps(1.0)
-    walker.kf.x[0] = 5.55 + tracker.assoc.recover_radius_m + 0.1  # beyond reach
+    walker.kf.x[0] = 5.55 + tracker.assoc.recover_radius_m + 0.1  # beyond reach, but last
+    assert stander in tracker._first_steps(1.0)  # seen within it: it may have run ahead of them
+    walker.seen_position = walker.position.copy()  # seen beyond reach
     assert stander not in tracker._first_steps(1.0)
+    # seed 80 (development), person 8 at 402.6 s: their track set off on the swinging leg and
+    # ran 0.4 m ahead of them, beyond reach of the place, while the track taken up behind
+    # walked on with them: not reported either while it keeps within reach of their track
+    stander.kf.x[0] = walker.kf.x[0] - 0.4
+    assert stander in tracker._first_steps(1.0)
     walker.kf.x[0] = 5.9
     stander.retaken_beside = None
     assert stander not in tracker._first_steps(1.0)
+    # seed 80, person 7 at 319 s: the track taken up behind them was handed the id it was
+    # taken up beside (their standing track died behind them): it is theirs, and reported
+    stander.retaken_beside = stander.track_id = 2
+    walker.track_id = 3
+    tracker._tracks = [stander]
+    stander.last_moving_update = 1.0  # walking
+    assert stander not in tracker._first_steps(1.0)
+
+
+def test_a_track_taken_up_behind_a_walker_takes_their_id_when_theirs_goes_as_a_duplicate():
+    """The track taken up again where someone stood (under a new id, theirs being alive on
+    the track that walked off with them) walks on beside their track until one goes as the
+    same person twice. When theirs goes, the one left takes their id: the person keeps it."""
+    from people_tracker.tracker.people_tracker import SET_OFF_S
+    tracker = PeopleTracker.from_config(load_config())
+    stander, walker = _stander_and_first_step(tracker)
+    stander.retaken_beside, stander.born = walker.track_id, 0.9
+    stander.kf.x[0], stander.kf.x[2] = walker.kf.x[0] + 0.1, walker.kf.x[2]
+    stander.last_moving_update = 1.0  # walking on beside the walker's track
+    tracker._tracks = [walker, stander]
+    tracker._duplicates = lambda stamp: {0}  # the walker's track goes
+    tracker._delete(1.0)
+    assert [t.track_id for t in tracker._tracks] == [walker.track_id] and stander.retaken_beside is None
+    stander.track_id, stander.retaken_beside = 7, walker.track_id
+    tracker._tracks = [walker, stander]
+    tracker._delete(0.9 + SET_OFF_S + 0.1)  # taken up long ago: someone else
+    assert [t.track_id for t in tracker._tracks] == [7]
 
 
 def test_a_walkers_leg_never_pairs_away_from_them_with_a_leg_nobody_owns():
