@@ -1177,10 +1177,12 @@ class PeopleTracker:
         whose track went off with a passer-by is reported once the passer-by is beyond reach."""
         walking = {t.track_id: t for t in self._tracks if t.confirmed and not t.still}
         r = self.assoc.recover_radius_m
+        def within_reach(u: TrackState, w: TrackState) -> bool:
+            return pairwise_distances(np.array([w.position, w.seen_position]),
+                                      np.array([u.origin, u.position])).min() <= r
+
         return [u for u in self._tracks if u.retaken_beside in walking and u.retaken_beside != u.track_id
-                and stamp - u.born <= SET_OFF_S and pairwise_distances(np.array([walking[u.retaken_beside].position,
-                                                 walking[u.retaken_beside].seen_position]),
-                                       np.array([u.origin, u.position])).min() <= r]
+                and stamp - u.born <= SET_OFF_S and within_reach(u, walking[u.retaken_beside])]
 
     def _hand_over(self, t: TrackState, living: list[TrackState], stamp: float) -> bool:
         """A person who stood still and set off: their place empties (the standing track
