@@ -495,7 +495,8 @@ class PeopleTracker:
         where the walking one began (it explains it better), or the walking one has taken
         an id already (:meth:`_hand_over`, :meth:`_walked_off_unseen`).
         Not while following someone (``follow``): the selector re-locks on the followed
-        person by its own rules, and the following scenes have not been measured with it."""
+        person by its own rules, and on the development following runs it gained nothing for
+        them and put the target on someone else more often (docs/track_evidence.md)."""
         self._vanished = [e for e in self._vanished if stamp - e.seen <= SET_OFF_S]
         if not self._vanished or self.selector is not None:
             return

@@ -800,8 +800,8 @@ def test_a_walker_whose_track_ended_unseen_gets_their_id_back_walking_on():
     1-2 s later, under a new id. A walking track confirmed within SET_OFF_S of the old one's
     last update, heading the same way, whose first place lies within
     association.recover_radius_m of where the old one would be by then, takes its id
-    (not while following someone: measured on the following scenes together with another
-    change, they lost, so they keep what they were measured with)."""
+    (not while following someone: measured on the development following runs, it gained
+    nothing for the followed person and put the target on someone else more often)."""
     from people_tracker.detection.free_space import OCCUPIED, SEEN_THROUGH
     from people_tracker.tracker.people_tracker import SET_OFF_S
 
