@@ -21,7 +21,7 @@ from people_tracker.detection.objects import MovingObject, describe_all
 from people_tracker.detection.recover import isolated_from_bounds, recover_from_bounds
 from people_tracker.detection.scan_lines import bin_to_beams, line_labels_kernel, scan_line_labels
 from people_tracker.detection.segments import means_and_chords, run_bounds
-from people_tracker.detection.thresholds import range_threshold
+from people_tracker.detection.thresholds import enough_readings, range_threshold, readings_needed
 from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D, pairwise_distances, transform_kernel
 from people_tracker.models.scan import Scan
@@ -42,10 +42,17 @@ class DetectorParams:
     compare_dt_s
         Δt to each earlier scan compared with, seconds (several: slow legs move enough over
         the longer ones).
-    min_seed_points
-        An M segment needs this many readings to seed an object.
-    min_object_points
-        Objects with fewer readings are noise.
+    min_seed_points, min_seed_width_m
+        An M segment needs as many readings as a moving part ``min_seed_width_m`` metres across
+        is sure to show at its range to seed an object, at most ``min_seed_points`` and at
+        least 1 (:func:`~people_tracker.detection.thresholds.readings_needed`; 0: the count
+        everywhere).
+    min_object_points, min_object_width_m
+        Objects with fewer readings than an object ``min_object_width_m`` metres across is
+        sure to show at their range are noise, never asking more than ``min_object_points``
+        readings nor fewer than 2 (:func:`~people_tracker.detection.thresholds.readings_needed`);
+        the same width on every laser. ``min_object_width_m`` 0: ``min_object_points``
+        readings everywhere (the paper's plain count, another size on every laser).
     max_object_size_m
         Join refuses to grow an object beyond this end-to-end length.
     single_object_max_o
@@ -87,7 +94,9 @@ class DetectorParams:
     scan_line_window: int = 1
     compare_dt_s: tuple[float, ...] = (0.15, 0.45)
     min_seed_points: int = 2
+    min_seed_width_m: float = 0.1
     min_object_points: int = 3
+    min_object_width_m: float = 0.15
     max_object_size_m: float = 1.0
     single_object_max_o: int = 1
     isolated_o_objects: bool = True
@@ -580,14 +589,16 @@ class MovingObjectDetector:
         run_labels = labels[valid]
         bounds = run_bounds(pts, gap, run_labels) if len(pts) else np.zeros(1, np.int64)  # split_runs' runs
         # 4. Algorithms 2 and 3: recover whole objects
-        found = recover_from_bounds(bounds, run_labels, pts, gap, p.min_seed_points, p.min_object_points,
+        need = readings_needed(scan.ranges[valid], scan.resolution, p.min_object_width_m, p.min_object_points)
+        seed_need = readings_needed(scan.ranges[valid], scan.resolution, p.min_seed_width_m, p.min_seed_points, 1)
+        found = recover_from_bounds(bounds, run_labels, pts, gap, seed_need, need,
                                     p.max_object_size_m, p.single_object_max_o)
         if p.isolated_o_objects:  # objects moving away, whatever else moves (extends Algorithm 3)
             taken = {(r.start, r.stop) for r in found}
             found += [r for r in isolated_from_bounds(bounds, run_labels, pts, scan.ranges[valid], gap,
-                                                      p.min_object_points, p.max_object_size_m)
+                                                      need, p.max_object_size_m)
                       if (r.start, r.stop) not in taken]
-        found = [seg for seg in found if seg.size >= p.min_object_points]
+        found = [seg for seg in found if enough_readings(need, seg.start, seg.stop)]
         # static things that flicker are not moving (extension, see DetectorParams)
         keep = self._static_memory(scan, pose, [(seg.start, seg.stop) for seg in found], pts,
                                    scan.ranges[valid], people, [MOVING in seg.sets for seg in found])

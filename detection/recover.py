@@ -6,6 +6,7 @@ import numpy as np
 
 from people_tracker.detection.labels import MOVING, OCCLUDED, STATIC
 from people_tracker.detection.segments import Segment, runs_of
+from people_tracker.detection.thresholds import enough_readings
 from people_tracker.models import compiled
 
 
@@ -63,12 +64,13 @@ def join(runs: list[Segment], into: int, source: int, points: np.ndarray, join_t
 
 
 def isolated_occluded(runs: list[Segment], points: np.ndarray, ranges: np.ndarray, gap: np.ndarray,
-                      min_points: int, max_extent: float) -> list[Segment]:
+                      need: np.ndarray, max_extent: float) -> list[Segment]:
     """O segments that stand in front of both neighbours: objects moving away.
 
     An object that moves away from the scanner lies wholly in O_C (the paper's case 3).
     Algorithm 3 recovers it only when the scene holds a single moving object. This
-    extension takes, whatever else moves, each O segment of ``min_points`` readings and at
+    extension takes, whatever else moves, each O segment of enough readings (``need``, per
+    reading: :func:`~people_tracker.detection.thresholds.enough_readings`) and at
     most ``max_extent`` metres end to end whose readings on either side are farther by more
     than the segment spacing threshold (or are missing): a free-standing thing, unlike
     the background a passing person reveals, which continues into the static surface
@@ -77,7 +79,7 @@ def isolated_occluded(runs: list[Segment], points: np.ndarray, ranges: np.ndarra
     out = []
     n = len(points)
     for r in runs:
-        if r.label != OCCLUDED or r.size < min_points:
+        if r.label != OCCLUDED or not enough_readings(need, r.start, r.stop):
             continue
         if np.hypot(*(points[r.stop - 1] - points[r.start])) > max_extent:
             continue
@@ -88,30 +90,33 @@ def isolated_occluded(runs: list[Segment], points: np.ndarray, ranges: np.ndarra
     return out
 
 
-def recover_moving(runs: list[Segment], points: np.ndarray, join_threshold: np.ndarray, min_seed: int,
-                   min_points: int, max_extent: float, single_object_max_o: int) -> list[Segment]:
+def recover_moving(runs: list[Segment], points: np.ndarray, join_threshold: np.ndarray, seed_need: np.ndarray,
+                   need: np.ndarray, max_extent: float, single_object_max_o: int) -> list[Segment]:
     """Algorithms 2 and 3: the segments that are moving objects.
 
     Algorithm 2: if M_C^s is not empty, Join(M_C^s, A_C^s) then Join(M_C^s, O_C^s).
     Algorithm 3: if M_C^s is empty and O_C^s is not, and the scene holds a single moving
-    object (at most ``single_object_max_o`` O_C segments of ``min_points`` readings),
-    M_C^s ← O_C^s.
+    object (at most ``single_object_max_o`` O_C segments of enough readings: ``need`` per
+    reading, see :func:`~people_tracker.detection.thresholds.enough_readings`), M_C^s ← O_C^s.
 
-    M segments of fewer than ``min_seed`` readings are noise and seed nothing.
+    M segments of fewer readings than ``seed_need`` asks (per reading, as ``need``) are noise
+    and seed nothing.
     """
-    runs = [r if r.label != MOVING or r.size >= min_seed else Segment(r.start, r.stop, -1, (-1,)) for r in runs]
+    runs = [r if r.label != MOVING or enough_readings(seed_need, r.start, r.stop) else Segment(r.start, r.stop, -1, (-1,))
+            for r in runs]
     if any(r.label == MOVING for r in runs):
         join(runs, MOVING, STATIC, points, join_threshold, max_extent)
         join(runs, MOVING, OCCLUDED, points, join_threshold, max_extent)
         return [r for r in runs if r.label == MOVING]
-    occluded = [r for r in runs if r.label == OCCLUDED and r.size >= min_points]
+    occluded = [r for r in runs if r.label == OCCLUDED and enough_readings(need, r.start, r.stop)]
     if 0 < len(occluded) <= single_object_max_o:
         return occluded
     return []
 
 
 def recover_from_bounds(bounds: np.ndarray, labels: np.ndarray, points: np.ndarray, join_threshold: np.ndarray,
-                        min_seed: int, min_points: int, max_extent: float, single_object_max_o: int) -> list[Segment]:
+                        seed_need: np.ndarray, need: np.ndarray, max_extent: float,
+                        single_object_max_o: int) -> list[Segment]:
     """:func:`recover_moving` of the runs ``bounds`` gives (run k is ``bounds[k]:bounds[k + 1]``
     of the valid readings, labelled ``labels[bounds[k]]``, as :func:`~people_tracker.detection.segments.run_bounds`
     returns them): the same segments, from one compiled call when the kernels are on (the
@@ -119,30 +124,30 @@ def recover_from_bounds(bounds: np.ndarray, labels: np.ndarray, points: np.ndarr
     if len(bounds) < 2:
         return []
     if not compiled.on:
-        return recover_moving(runs_of(bounds, labels), points, join_threshold, min_seed, min_points, max_extent,
+        return recover_moving(runs_of(bounds, labels), points, join_threshold, seed_need, need, max_extent,
                               single_object_max_o)
     starts, stops, labs, sets = _recover_kernel(bounds, np.ascontiguousarray(labels[bounds[:-1]], dtype=np.int64),
-                                                points, join_threshold, min_seed, min_points, max_extent,
+                                                points, join_threshold, seed_need, need, max_extent,
                                                 single_object_max_o)
     return [Segment(a, b, lab, _SETS[mask]) for a, b, lab, mask in
             zip(starts.tolist(), stops.tolist(), labs.tolist(), sets.tolist())]
 
 
 def isolated_from_bounds(bounds: np.ndarray, labels: np.ndarray, points: np.ndarray, ranges: np.ndarray,
-                         gap: np.ndarray, min_points: int, max_extent: float) -> list[Segment]:
+                         gap: np.ndarray, need: np.ndarray, max_extent: float) -> list[Segment]:
     """:func:`isolated_occluded` of the runs ``bounds`` gives (as :func:`recover_from_bounds`
     takes them; ``ranges`` and ``gap`` per valid reading): the same segments, from one
     compiled call when the kernels are on."""
     if len(bounds) < 2:
         return []
     if not compiled.on:
-        return isolated_occluded(runs_of(bounds, labels), points, ranges, gap, min_points, max_extent)
-    starts, stops = _isolated_kernel(bounds, labels, points, ranges, gap, min_points, max_extent)
+        return isolated_occluded(runs_of(bounds, labels), points, ranges, gap, need, max_extent)
+    starts, stops = _isolated_kernel(bounds, labels, points, ranges, gap, need, max_extent)
     return [Segment(a, b, OCCLUDED, (OCCLUDED,)) for a, b in zip(starts.tolist(), stops.tolist())]
 
 
-def _isolated_loop(bounds, run_labels, points, ranges, gap, min_points, max_extent):
-    """The O runs of at least ``min_points`` readings (``bounds``: the runs' first readings
+def _isolated_loop(bounds, run_labels, points, ranges, gap, need, max_extent):
+    """The O runs of enough readings (``need``, as :func:`isolated_occluded`; ``bounds``: the runs' first readings
     and one past the last; ``run_labels``: each valid reading's label) that
     :func:`isolated_occluded` keeps, as one loop (compiled by numba; its tests in its
     order): their first readings and one past their last."""
@@ -151,7 +156,7 @@ def _isolated_loop(bounds, run_labels, points, ranges, gap, min_points, max_exte
     k = 0
     for r in range(len(bounds) - 1):
         a, b = bounds[r], bounds[r + 1]
-        if run_labels[a] != OCCLUDED or b - a < min_points:
+        if run_labels[a] != OCCLUDED or b - a < max(need[a], need[b - 1]):
             continue
         if np.hypot(points[b - 1, 0] - points[a, 0], points[b - 1, 1] - points[a, 1]) > max_extent:
             continue
@@ -203,7 +208,7 @@ def _join_runs(start, stop, lab, sets, alive, prev, nxt, gap_m, close, into, sou
             prev[after] = a
 
 
-def _recover_loop(bounds, run_labels, points, join_threshold, min_seed, min_points, max_extent, single_object_max_o):
+def _recover_loop(bounds, run_labels, points, join_threshold, seed_need, need, max_extent, single_object_max_o):
     """:func:`recover_moving` on the runs of ``bounds``: the recovered segments' starts,
     stops, labels and sets (bit masks), in beam order."""
     n = len(bounds) - 1
@@ -213,7 +218,7 @@ def _recover_loop(bounds, run_labels, points, join_threshold, min_seed, min_poin
     any_moving = False
     for i in range(n):
         if lab[i] == MOVING:
-            if stop[i] - start[i] < min_seed:
+            if stop[i] - start[i] < max(seed_need[start[i]], seed_need[stop[i] - 1]):
                 lab[i] = -1  # noise: seeds nothing
             else:
                 any_moving = True
@@ -239,7 +244,7 @@ def _recover_loop(bounds, run_labels, points, join_threshold, min_seed, min_poin
     else:
         count = 0
         for i in range(n):
-            if lab[i] == OCCLUDED and stop[i] - start[i] >= min_points:
+            if lab[i] == OCCLUDED and stop[i] - start[i] >= max(need[start[i]], need[stop[i] - 1]):
                 keep[i] = True
                 count += 1
         if count > single_object_max_o:

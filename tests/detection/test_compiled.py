@@ -528,7 +528,9 @@ def test_recovering_objects_agrees():
             gap[rng.integers(0, n)] = np.nan
         labels = rng.choice([1, 2, 3, 4], n, p=[0.5, 0.1, 0.3, 0.1] if k % 3 else [0.6, 0.0, 0.3, 0.1]).astype(np.int8)
         bounds = run_bounds(pts, gap, labels) if n else np.zeros(1, np.int64)
-        args = (bounds, labels, pts, gap, int(rng.integers(1, 4)), int(rng.integers(1, 5)), float(rng.uniform(0.3, 2)),
+        need = rng.integers(1, 5, n).astype(np.int64)  # readings an object needs, per reading (thresholds.readings_needed)
+        seed_need = rng.integers(1, 4, n).astype(np.int64)
+        args = (bounds, labels, pts, gap, seed_need, need, float(rng.uniform(0.3, 2)),
                 int(rng.integers(0, 3)))
         fast = recover_from_bounds(*args)
         with compiled.numpy_only():
@@ -594,13 +596,13 @@ def test_the_static_memorys_span_helpers_agree():
         gap = rng.uniform(0.02, 0.12, n)
         labels = rng.choice([1, 2, 3, 4], n, p=[0.3, 0.2, 0.4, 0.1]).astype(np.int8)
         bounds = run_bounds(pts, gap, labels)
-        min_points, extent = int(rng.integers(1, 5)), float(rng.uniform(0.1, 1.0))
-        fast = isolated_from_bounds(bounds, labels, pts, ranges, gap, min_points, extent)
+        need, extent = rng.integers(1, 5, n).astype(np.int64), float(rng.uniform(0.1, 1.0))
+        fast = isolated_from_bounds(bounds, labels, pts, ranges, gap, need, extent)
         with compiled.numpy_only():
-            assert isolated_from_bounds(bounds, labels, pts, ranges, gap, min_points, extent) == fast, k
+            assert isolated_from_bounds(bounds, labels, pts, ranges, gap, need, extent) == fast, k
         big = [Segment(int(s), int(e), OCCLUDED, (OCCLUDED,)) for s, e in zip(bounds[:-1], bounds[1:])
-               if labels[s] == OCCLUDED and e - s >= min_points]
-        ref = isolated_occluded(big, pts, ranges, gap, min_points, extent)
+               if labels[s] == OCCLUDED and e - s >= max(need[s], need[e - 1])]
+        ref = isolated_occluded(big, pts, ranges, gap, need, extent)
         assert fast == ref, k
         kept += len(ref)
     assert kept > 300

@@ -82,9 +82,10 @@ def test_algorithm3_replaces_only_under_the_single_object_condition():
     pts = np.column_stack([np.zeros(12), np.arange(12) * 0.05])
     thr = np.full(12, 0.01)  # nothing joins
     one_o = [Segment(0, 6, STATIC, (STATIC,)), Segment(6, 10, OCCLUDED, (OCCLUDED,))]
-    assert [(r.start, r.stop) for r in recover_moving(one_o, pts, thr, 2, 3, 1.0, 1)] == [(6, 10)]
+    need = np.full(12, 3)  # readings an object needs (thresholds.readings_needed)
+    assert [(r.start, r.stop) for r in recover_moving(one_o, pts, thr, need - 1, need, 1.0, 1)] == [(6, 10)]
     two_o = [Segment(0, 4, OCCLUDED, (OCCLUDED,)), Segment(4, 6, STATIC, (STATIC,)), Segment(6, 10, OCCLUDED, (OCCLUDED,))]
-    assert recover_moving(two_o, pts, thr, 2, 3, 1.0, 1) == []
+    assert recover_moving(two_o, pts, thr, need - 1, need, 1.0, 1) == []
 
 
 def test_describe_gives_hull_centroid_and_a_rectangle_with_width_below_length():

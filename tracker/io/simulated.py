@@ -17,11 +17,18 @@ from people_tracker.tracker.io.recording import ScanRecord
 DEFAULT_SCENE = "crossing"
 
 
-def _load(scenario: str, seed: int | None, people: int | None, duration: float | None, laser: str | None = None):
+def _load(scenario: str, seed: int | None, people: int | None, duration: float | None, laser: str | None = None,
+          resolution_deg: float | None = None):
     try:
         spec = load_scenario(scenario)
         if duration is not None:
             spec = {**spec, "duration_s": duration}
+        if resolution_deg is not None:  # the same laser with another angular step (degrees)
+            if laser is None:
+                spec = {**spec, "laser": {**(spec.get("laser") or {}), "resolution_deg": resolution_deg}}
+            elif isinstance(spec.get("lasers"), dict) and isinstance(spec["lasers"].get(laser), dict):
+                spec = {**spec, "lasers": {**spec["lasers"], laser: {**spec["lasers"][laser],
+                                                                     "resolution_deg": resolution_deg}}}
         return build_simulation(spec, seed=seed, crowd_count=people, laser=laser)
     except ScenarioError as exc:
         raise InputError(str(exc)) from None
@@ -35,8 +42,9 @@ class SimulatedSource:
     """
 
     def __init__(self, scenario: str = DEFAULT_SCENE, seed: int | None = None, people: int | None = None,
-                 duration: float | None = None, laser: str | None = None) -> None:
-        self.sim, self.scan_count = _load(scenario, seed, people, duration, laser)
+                 duration: float | None = None, laser: str | None = None,
+                 resolution_deg: float | None = None) -> None:
+        self.sim, self.scan_count = _load(scenario, seed, people, duration, laser, resolution_deg)
         self.path = f"built-in scene '{scenario}'"
         self.topic = "/scan"
         self.laser_frame = self.sim.laser.frame_id
