@@ -7,7 +7,8 @@ see each walker at another time). With the robot held still the two scans are ex
 detection and track must agree to the micrometre. Moving, the two lasers fire each beam
 from another place on the robot's path, so a leg is crossed by other rays: after de-skew
 the hull centroids agree to a centimetre at the median, and objects at the edge of the
-size threshold (2 or 3 readings) may be found by one laser only.
+size threshold (2 or 3 readings, the count a width of detector.min_object_width_m takes at
+that range) may be found by one laser only.
 """
 
 from __future__ import annotations
@@ -80,7 +81,9 @@ def test_still_sensor_gives_the_same_detections_and_tracks_either_way(name):
 def test_moving_sensor_gives_the_same_detections_and_tracks_either_way(name):
     ccw, cw = _run(name, False, still=False), _run(name, True, still=False)
     dist, unpaired = _pair_up(ccw[0], cw[0])
-    assert len(dist) > 100 and np.median(dist) < 0.01 and unpaired <= 0.10, (np.median(dist), unpaired)
+    # unpaired measured on room_drive: 9.7 % with a fixed 3-reading size rule, 10.1 % with the
+    # width rule (4 more one-laser objects, all beyond 6 m where 2 readings now suffice)
+    assert len(dist) > 100 and np.median(dist) < 0.01 and unpaired <= 0.12, (np.median(dist), unpaired)
     # tracks carry the same sampling differences through the leg model's scores (a standing
     # leg scored just above its threshold in one direction, just below in the other, so a
     # start a few scans earlier or later) and the filter: measured 1.0 cm median on
