@@ -30,8 +30,8 @@ def readings_needed(ranges: np.ndarray, resolution: float, width_m: float, most:
     ``width_m`` metres across is sure to show there (its width over the beam spacing
     ``r · res``, rounded down), never more than ``most`` nor fewer than ``least``.
 
-    A count of readings alone would mean another size on every laser: 3 readings are 3.5 cm
-    of a person at 2 m on a 0.33° laser and 21 cm at 4 m on a 1° one, wider than a leg.
+    A count of readings alone would mean another size on every laser: three beam spacings
+    are 3.5 cm at 2 m on a 0.33° laser and 21 cm at 4 m on a 1° one, wider than a leg.
     ``width_m`` 0 asks ``most`` everywhere (a plain count).
 
     Parameters
@@ -43,7 +43,9 @@ def readings_needed(ranges: np.ndarray, resolution: float, width_m: float, most:
     width_m : float
         Width of the narrowest object to keep (a leg), metres.
     most, least : int
-        Bounds on the count (``least`` ≥ 1: a single reading is noise on any laser).
+        Bounds on the count: 2 at least for an object (a lone reading is noise on any
+        laser), 1 for the moving part that seeds one (the object it grows into must still
+        hold 2).
     """
     r = np.asarray(ranges, dtype=float)
     if width_m <= 0:

@@ -98,3 +98,27 @@ def test_the_benchmarks_refuse_a_bad_configuration_in_one_line(tmp_path, script)
                           timeout=120)
     assert proc.returncode == 2 and proc.stdout == "", proc
     assert proc.stderr.count("\n") == 1 and "same_person_after_s" in proc.stderr, proc.stderr
+
+
+def test_track_evidence_refuses_a_laser_step_out_of_range_in_one_line():
+    import subprocess
+    import sys
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "track_evidence.py"
+    proc = subprocess.run([sys.executable, str(path), "--resolution", "10"], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 2 and proc.stdout == "", proc
+    assert proc.stderr.count("\n") == 1 and "--resolution" in proc.stderr, proc.stderr
+
+
+@pytest.mark.parametrize("scene, laser", [("crossing", None), ("follow_outdoor", "long_cw")])
+def test_a_simulated_scene_runs_on_another_laser_step(scene, laser):
+    import math
+    from people_tracker.tracker.io.simulated import SimulatedSource
+    own = next(iter(SimulatedSource(scene, duration=0.5, laser=laser).scans())).scan
+    coarse = next(iter(SimulatedSource(scene, duration=0.5, laser=laser, resolution_deg=1.0).scans())).scan
+    assert math.isclose(coarse.resolution, math.radians(1.0), rel_tol=1e-9)
+    assert own.resolution < coarse.resolution
+    # the same field of view, fewer beams
+    fov = lambda s: s.resolution * (len(s.ranges) - 1)
+    assert abs(fov(own) - fov(coarse)) < math.radians(1.0) and len(coarse.ranges) < len(own.ranges)
