@@ -178,6 +178,7 @@ class AssociationConfig:
     support_radius_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
     support_sigma_m: float = field(metadata=_spec(lo=0.0, lo_open=True, hi=10.0))
     support_min_points: int = field(metadata=_spec(lo=1, hi=10000))
+    support_min_width_m: float = field(metadata=_spec(lo=0.0, hi=10.0))
     support_anchor_m: float = field(metadata=_spec(lo=0.0, hi=100.0))
     free_space_lookback_s: float = field(metadata=_spec(lo=0.0, hi=60.0))
     free_space_margin_m: float = field(metadata=_spec(lo=0.0, hi=10.0))

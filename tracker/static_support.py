@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from people_tracker.detection.segments import run_bounds, segment_of_readings
-from people_tracker.detection.thresholds import range_threshold
+from people_tracker.detection.thresholds import range_threshold, readings_needed
 from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D, pairwise_distances
 from people_tracker.models.scan import Scan
@@ -28,7 +28,8 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
                    min_points: int, max_leg_radius_m: float = 0.0,
                    explained: np.ndarray | None = None,
                    needed: np.ndarray | None = None,
-                   segmentation: tuple[np.ndarray, int] | None = None) -> list[np.ndarray | None]:
+                   segmentation: tuple[np.ndarray, int] | None = None,
+                   min_width_m: float = 0.0) -> list[np.ndarray | None]:
     """For each predicted position (world frame, m), a supporting position or None.
 
     Parameters
@@ -44,7 +45,12 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
     max_size_m : float
         Largest extent (bounding-box diagonal) of a person, metres.
     min_points : int
-        Fewest readings that support a person.
+        Fewest readings that support a person, where the beams are dense enough that ...
+    min_width_m : float
+        ... something this wide (metres) at the prediction's range is sure to show that many;
+        elsewhere as many as it shows there, at least 2
+        (:func:`~people_tracker.detection.thresholds.readings_needed`). 0: ``min_points``
+        everywhere.
     max_leg_radius_m : float
         The position is where the legs' centres are, behind the readings (as
         :func:`~people_tracker.tracker.pairing.leg_centres` steps back a leg, taking half the
@@ -54,7 +60,7 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         Readings another person's moving candidate took this scan: they support nobody
         else (a passer-by's leg beside someone standing must not pull them along).
     needed : ndarray of bool, shape (n_beams,), optional
-        A group must hold at least ``min_points`` of these readings.
+        A group must hold at least as many of these readings as it needs in all.
     segmentation : (ndarray, int), optional
         :func:`scan_segments` of this scan with these ``k_segment`` and ``segment_floor_m``,
         when the caller keeps it for several calls on one scan.
@@ -66,12 +72,13 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
     pts = scan.valid_points
     seg_of, n_segments = segmentation if segmentation is not None else scan_segments(scan, k_segment, segment_floor_m)
     pred_sensor = pose.inverse().transform_points(predictions_world)
+    need = readings_needed(np.hypot(pred_sensor[:, 0], pred_sensor[:, 1]), scan.resolution, min_width_m, min_points)
     free = np.ones(len(valid), dtype=bool) if explained is None else ~explained[valid]
     needed_valid = None if needed is None else needed[valid]  # per valid reading, as ``free``
     if compiled.on:  # the loop below, compiled: each prediction's group, checked and centred
         found, centres = _support_kernel(
             pred_sensor, pts, seg_of, n_segments, free, needed_valid is not None,
-            needed_valid if needed_valid is not None else free, radius_m, max_size_m, min_points, max_leg_radius_m)
+            needed_valid if needed_valid is not None else free, radius_m, max_size_m, need, max_leg_radius_m)
         if found.any():
             for t in np.flatnonzero(found).tolist():
                 out[t] = pose.transform_points(centres[t:t + 1])[0]
@@ -88,9 +95,9 @@ def static_support(predictions_world: np.ndarray, pose: Pose2D, scan: Scan, k_se
         members = chosen[seg_of] & free
         p = pts[members]
         extent = np.hypot(*np.ptp(p, axis=0)) if len(p) else 0.0
-        if len(p) < min_points or extent > max_size_m:
+        if len(p) < need[t] or extent > max_size_m:
             continue
-        if needed_valid is not None and np.count_nonzero(needed_valid[members]) < min_points:
+        if needed_valid is not None and np.count_nonzero(needed_valid[members]) < need[t]:
             continue
         centre = p.mean(axis=0, keepdims=True)
         if max_leg_radius_m > 0:
@@ -108,7 +115,7 @@ def scan_segments(scan: Scan, k_segment: float, segment_floor_m: float) -> tuple
     return segment_of_readings(bounds), len(bounds) - 1
 
 
-def _support_loop(pred_sensor, pts, seg_of, n_segments, free, use_needed, needed, radius_m, max_size_m, min_points,
+def _support_loop(pred_sensor, pts, seg_of, n_segments, free, use_needed, needed, radius_m, max_size_m, need,
                   max_leg_radius_m):
     """:func:`static_support`'s loop over the predictions (sensor frame) as its numpy code
     runs it, the same arithmetic in the same order: whether each is supported, and where
@@ -144,9 +151,9 @@ def _support_loop(pred_sensor, pts, seg_of, n_segments, free, use_needed, needed
                 x_lo, x_hi = min(x_lo, x), max(x_hi, x)
                 y_lo, y_hi = min(y_lo, y), max(y_hi, y)
         extent = np.hypot(x_hi - x_lo, y_hi - y_lo)
-        if count < min_points or extent > max_size_m:
+        if count < need[t] or extent > max_size_m:
             continue
-        if use_needed and count_needed < min_points:
+        if use_needed and count_needed < need[t]:
             continue
         mx, my = sx / count, sy / count
         if max_leg_radius_m > 0:  # leg_centres: a step back along the beam

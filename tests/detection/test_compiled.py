@@ -166,12 +166,12 @@ def test_static_support_agrees_on_simulated_lasers(laser):
         near = pts[rng.integers(0, len(pts), 30)] + rng.normal(0.0, 0.2, (30, 2))  # beside readings, and not
         predictions = pose.transform_points(np.vstack([near, rng.uniform(-8, 8, (10, 2))]))
         masks = rng.random((2, scan.n_beams)) < np.array([[0.2], [0.7]])
-        for explained, needed, leg_radius in ((None, None, 0.0), (masks[0], None, 0.1), (None, masks[1], 0.06),
-                                              (masks[0], masks[1], 0.1)):
+        for explained, needed, leg_radius, width in ((None, None, 0.0, 0.0), (masks[0], None, 0.1, 0.15),
+                                                     (None, masks[1], 0.06, 0.3), (masks[0], masks[1], 0.1, 0.0)):
             args = (predictions, pose, scan, 2.5, 0.1, 0.3, 0.8, 3, leg_radius, explained, needed)
-            fast = static_support(*args)
+            fast = static_support(*args, min_width_m=width)  # widths: counts of 3 near, 2 farther
             with compiled.numpy_only():
-                ref = static_support(*args)
+                ref = static_support(*args, min_width_m=width)
             assert [None if f is None else f.tobytes() for f in fast] == \
                 [None if r is None else r.tobytes() for r in ref]
             supported += sum(f is not None for f in fast)

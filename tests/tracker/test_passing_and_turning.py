@@ -1078,3 +1078,24 @@ def test_a_track_begun_where_the_person_was_still_takes_the_target_off_one_that_
     tracker, pid = _closing_in(walker_age_s=0.0)
     assert tracker.selector.lost_since is not None
     assert tracker._tracks[0].track_id != pid
+
+
+def test_static_support_asks_what_a_leg_shows_at_its_range_on_any_laser():
+    # one standing leg (12 cm across) 4 m out, between two beams of a 1° laser: 2 readings
+    # there, 5 on a 0.35° one
+    leg = [4.0 * math.cos(math.radians(0.5)), 4.0 * math.sin(math.radians(0.5))]
+    coarse, fine = {**LASER, "resolution_deg": 1.0}, LASER
+    for laser, width, found in ((coarse, 0.15, True), (coarse, 0.0, False), (fine, 0.15, True), (fine, 0.0, True)):
+        sim, _ = build_simulation({"duration_s": 1, "laser": laser,
+                                   "world": {"room": [-1, -6, 8, 6], "pillars": [[*leg, 0.06]]}})
+        scan = sim.step().scan
+        shown = int((np.hypot(*(scan.valid_points - leg).T) < 0.2).sum())
+        assert shown == 2 if laser is coarse else shown >= 4
+        got = static_support(np.array([leg]), Pose2D(), scan, 12.0, 0.06, 0.35, 0.8, 3, min_width_m=width)[0]
+        assert (got is not None) == found, (laser["resolution_deg"], width)
+    # and 2 readings stay too few where a leg shows 3 or more: a 1-cm stub 4 m out on 0.35°
+    sim, _ = build_simulation({"duration_s": 1, "laser": fine,
+                               "world": {"room": [-1, -6, 8, 6], "pillars": [[*leg, 0.01]]}})
+    scan = sim.step().scan
+    assert 1 <= (np.hypot(*(scan.valid_points - leg).T) < 0.2).sum() <= 2
+    assert static_support(np.array([leg]), Pose2D(), scan, 12.0, 0.06, 0.35, 0.8, 3, min_width_m=0.15)[0] is None
