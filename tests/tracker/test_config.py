@@ -86,27 +86,26 @@ def test_a_scripts_bad_configuration_is_one_line_and_exit_2(tmp_path, capsys):
     assert load_config_or_exit("outdoors", "script") == load_config("outdoors")
 
 
-@pytest.mark.parametrize("script", ["following.py", "track_evidence.py", "follow_closed_loop.py"])
-def test_the_benchmarks_refuse_a_bad_configuration_in_one_line(tmp_path, script):
+def _benchmark(script: str, *args: str):
+    """Run ``benchmarks/SCRIPT ARGS`` as a user would; the finished process."""
     import subprocess
     import sys
     from pathlib import Path
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / script
+    return subprocess.run([sys.executable, str(path), *args], capture_output=True, text=True, timeout=120)
+
+
+@pytest.mark.parametrize("script", ["following.py", "track_evidence.py", "follow_closed_loop.py"])
+def test_the_benchmarks_refuse_a_bad_configuration_in_one_line(tmp_path, script):
     bad = tmp_path / "bad.yaml"
     bad.write_text("tracks:\n  same_person_after_s: -1\n")
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / script
-    proc = subprocess.run([sys.executable, str(path), "--config", str(bad)], capture_output=True, text=True,
-                          timeout=120)
+    proc = _benchmark(script, "--config", str(bad))
     assert proc.returncode == 2 and proc.stdout == "", proc
     assert proc.stderr.count("\n") == 1 and "same_person_after_s" in proc.stderr, proc.stderr
 
 
 def test_track_evidence_refuses_a_laser_step_out_of_range_in_one_line():
-    import subprocess
-    import sys
-    from pathlib import Path
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "track_evidence.py"
-    proc = subprocess.run([sys.executable, str(path), "--resolution", "10"], capture_output=True, text=True,
-                          timeout=120)
+    proc = _benchmark("track_evidence.py", "--resolution", "10")
     assert proc.returncode == 2 and proc.stdout == "", proc
     assert proc.stderr.count("\n") == 1 and "--resolution" in proc.stderr, proc.stderr
 
@@ -120,5 +119,5 @@ def test_a_simulated_scene_runs_on_another_laser_step(scene, laser):
     assert math.isclose(coarse.resolution, math.radians(1.0), rel_tol=1e-9)
     assert own.resolution < coarse.resolution
     # the same field of view, fewer beams
-    fov = lambda s: s.resolution * (len(s.ranges) - 1)
-    assert abs(fov(own) - fov(coarse)) < math.radians(1.0) and len(coarse.ranges) < len(own.ranges)
+    fov_own, fov_coarse = (s.resolution * (len(s.ranges) - 1) for s in (own, coarse))
+    assert abs(fov_own - fov_coarse) < math.radians(1.0) and len(coarse.ranges) < len(own.ranges)
