@@ -87,9 +87,13 @@ def describe_all(first_id: int, beams: list[np.ndarray], points: list[np.ndarray
         return [MovingObject(first_id + k, beams[k], points[k], float(cx[k]), float(cy[k]), float(width[k]),
                              float(length[k]), recovered_name(sets[k])) for k in range(len(points))]
     clouds = shapely.multipoints(np.concatenate(points), indices=np.repeat(np.arange(len(points)), counts))
-    centroids = shapely.centroid(shapely.convex_hull(clouds))
+    # GEOS divides by a side's length, which underflows for objects a few nanometres across
+    # (readings of 1e-200 m, say, when a driver's range_min is 0): the rectangle it returns is
+    # still right to within rounding, so the floating-point warnings say nothing to a user
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        centroids = shapely.centroid(shapely.convex_hull(clouds))
+        rects = shapely.minimum_rotated_rectangle(clouds)
     cx, cy = shapely.get_x(centroids), shapely.get_y(centroids)
-    rects = shapely.minimum_rotated_rectangle(clouds)
     # collinear or a single point: a line (or point) with a length and no width
     width, length = np.zeros(len(points)), shapely.length(rects)
     box = (shapely.get_type_id(rects) == shapely.GeometryType.POLYGON) & ~shapely.is_empty(rects)

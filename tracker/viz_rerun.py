@@ -168,8 +168,9 @@ class RerunSink(Sink):
         for o in result.detection.objects:
             pts = pose.transform_points(o.points)
             cloud = shapely.multipoints(pts)
-            hull = shapely.convex_hull(cloud)
-            rect = shapely.minimum_rotated_rectangle(cloud)
+            with np.errstate(all="ignore"):  # as in detection.objects: sub-micrometre objects
+                hull = shapely.convex_hull(cloud)
+                rect = shapely.minimum_rotated_rectangle(cloud)
             for geom, out in ((hull, hulls), (rect, boxes)):
                 if isinstance(geom, shapely.Polygon):
                     out.append(np.asarray(geom.exterior.coords))

@@ -1,6 +1,7 @@
 """The detector's stages one by one, on hand-made inputs."""
 
 import math
+from contextlib import nullcontext
 
 import numpy as np
 import pytest
@@ -9,11 +10,12 @@ from people_tracker.detection.closest import closest_point_static
 from people_tracker.detection.detector import DetectorParams, MovingObjectDetector, combine, label_pair
 from people_tracker.detection.kdtree import BACKENDS, PointTree
 from people_tracker.detection.labels import INVALID, MOVING, OCCLUDED, OUT_OF_VIEW, STATIC
-from people_tracker.detection.objects import describe, recovered_name
+from people_tracker.detection.objects import describe, describe_all, recovered_name
 from people_tracker.detection.recover import join, recover_moving
 from people_tracker.detection.scan_lines import bin_to_beams, scan_line_labels
 from people_tracker.detection.segments import Segment, split_runs
 from people_tracker.detection.thresholds import range_threshold
+from people_tracker.models import compiled
 from people_tracker.models.pose import Pose2D
 from people_tracker.models.scan import Scan
 
@@ -97,6 +99,19 @@ def test_describe_gives_hull_centroid_and_a_rectangle_with_width_below_length():
     assert 1.9 < o.x < 1.96 and abs(o.y) < 1e-9
     line = describe(8, np.arange(3), np.array([[1.0, 0], [1.0, 0.1], [1.0, 0.2]]), (OCCLUDED,))
     assert line.width == 0.0 and line.length == pytest.approx(0.2) and line.recovered_from == "O"
+
+
+@pytest.mark.filterwarnings("error::RuntimeWarning")
+@pytest.mark.parametrize("kernels", [True, False])
+def test_describe_is_quiet_and_finite_on_an_object_nanometres_across(kernels):
+    """Readings of 1e-209 m (a driver whose range_min is 0): GEOS's rectangle divides by a
+    side that underflows; the box is still a point-sized one and nothing is printed."""
+    pts = np.array([[4.55e-209, 6.83e-210], [6.32e-6, 7.75e-6], [1.11e-218, 1.52e-218],
+                    [-4.24e-39, 1.10e-38], [-5.03e-13, 8.64e-13]])
+    with (nullcontext() if kernels else compiled.numpy_only()):
+        o = describe_all(0, [np.arange(5)], [pts], [(MOVING,)])[0]
+    assert all(np.isfinite([o.x, o.y, o.width, o.length]))
+    assert o.width <= o.length < 2e-5 and 0 <= o.x < 1e-5
 
 
 def test_recovered_names():

@@ -3,7 +3,8 @@
 ``PeopleTracker.step`` is driven with random scans (any beam count and increment, readings
 that are nan, inf, 0, negative or huge), poses (non-finite ones included), and stamps that
 repeat, go backwards or jump. The only exception allowed is the documented ``ValueError``
-of a malformed :class:`Scan`, raised when the scan is built, never inside ``step``.
+of a malformed :class:`Scan`, raised when the scan is built, never inside ``step``; nor may
+numpy print a floating-point warning.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import logging
 import math
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -53,6 +55,7 @@ def steps(draw):
     return out
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")  # numpy's floating-point warnings reach a user's console
 @settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(steps(), st.sampled_from([None, "auto"]))
 def test_step_never_raises_on_what_a_robot_can_send(run, follow):
