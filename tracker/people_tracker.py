@@ -504,7 +504,10 @@ class PeopleTracker:
         Not while following someone (``follow``): the selector re-locks on the followed
         person by its own rules, and on the development following runs it gained nothing for
         them and put the target on someone else more often (docs/track_evidence.md)."""
-        self._vanished = [e for e in self._vanished if stamp - e.seen <= SET_OFF_S]
+        # a track born within SET_OFF_S of their last update may be confirmed up to
+        # max_tentative_s later: the window counts to when they are seen again, not confirmed
+        self._vanished = [e for e in self._vanished
+                          if stamp - e.seen <= SET_OFF_S + self.track_params.max_tentative_s]
         if not self._vanished or self.selector is not None:
             return
         taken = self._take_remembered_ids(

@@ -797,15 +797,16 @@ def test_a_walker_whose_track_ended_unseen_gets_their_id_back_walking_on():
     glimpsed on two readings, too few to be seen moving; their place was in view and occupied,
     so each scan counted against a walker that should be seen moving, and the track ended
     within a second, its prediction still within 0.1 m of them. A new track took them up
-    1-2 s later, under a new id. A walking track confirmed within SET_OFF_S of the old one's
-    last update, heading the same way, whose first place lies within
+    1-2 s later, under a new id. A walking track born within SET_OFF_S of the old one's
+    last update (and confirmed within tracks.max_tentative_s after), heading the same way, whose first place lies within
     association.recover_radius_m of where the old one would be by then, takes its id
     (not while following someone: measured on the development following runs, it gained
     nothing for the followed person and put the target on someone else more often)."""
     from people_tracker.detection.free_space import OCCUPIED, SEEN_THROUGH
     from people_tracker.tracker.people_tracker import SET_OFF_S
 
-    def case(born_at=(4.0, 0.1), born_s=101.5, heading=1.0, ended=OCCUPIED, someone_at=None, follow=None):
+    def case(born_at=(4.0, 0.1), born_s=101.5, heading=1.0, ended=OCCUPIED, someone_at=None, follow=None,
+             confirmed_after_s=0.3):
         tracker = PeopleTracker.from_config(load_config(), follow=follow)
         old = _two_tracks()._tracks[0]  # a confirmed walking track (born moving) ...
         old.track_id, old.visibility = 7, ended
@@ -823,7 +824,7 @@ def test_a_walker_whose_track_ended_unseen_gets_their_id_back_walking_on():
             tracker._tracks[-1].kf.x[::2] = someone_at
             tracker._tracks[-1].confirmed = True
         u.confirmed = True  # confirmed this scan
-        stamp = born_s + 0.3
+        stamp = born_s + confirmed_after_s
         u.confirmed_at = stamp
         tracker._walked_on_unseen(stamp)
         return u.track_id
@@ -833,6 +834,9 @@ def test_a_walker_whose_track_ended_unseen_gets_their_id_back_walking_on():
     assert case(heading=-1.0) != 7  # walking the other way: someone else
     assert case(born_at=(4.0, 1.0)) != 7  # farther than association.recover_radius_m
     assert case(born_at=(2.0 + SET_OFF_S + 0.2, 0.0), born_s=100.0 + SET_OFF_S + 0.2) != 7  # too late
+    # seen again in time, confirmed later (development seeds 77 and 80: 3.1 s after the old
+    # track's last update): the window counts to the new track's birth
+    assert case(born_at=(2.0 + SET_OFF_S - 0.5, 0.0), born_s=100.0 + SET_OFF_S - 0.5, confirmed_after_s=1.5) == 7
     assert case(someone_at=(4.0, 0.05)) != 7  # the tracked one is nearer
     assert case(someone_at=(6.0, 0.0)) == 7
     assert case(follow="auto") != 7  # not while following (the selector re-locks by its own rules)
