@@ -864,7 +864,10 @@ class PeopleTracker:
         confirmed tracks no candidate reached this scan, and the tentative ones that began
         standing where someone arrived (their place seen empty before): someone who stands
         with their legs together, one segment the leg model scores low, earns their
-        confirmation by staying (``existence.present_lr``), as a confirmed person keeps it."""
+        confirmation by staying (``existence.present_lr``), as a confirmed person keeps it.
+        A walking track (not still) is not held by readings where the place memory says the
+        laser only ever saw something (``OCCUPIED_ONLY``): a walker hidden beside furniture
+        walks on, and someone who stops stands where it was empty before."""
         idle = [i for i, t in enumerate(self._tracks) if i not in matched and (
             t.confirmed or (t.born_standing and not t.moved and t.existence.walked_or_arrived))]
         if not idle:
@@ -883,6 +886,8 @@ class PeopleTracker:
         for i, z in zip(idle, found):
             t = self._tracks[i]
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
+                if not t.still and self._place_history(z, scan.stamp) == PlaceMemory.OCCUPIED_ONLY:
+                    continue  # a walker hidden beside furniture: the readings are the room's, not theirs
                 t.update(z, R, moving=False)
 
     def _walkers_now(self) -> np.ndarray:

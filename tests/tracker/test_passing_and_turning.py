@@ -320,6 +320,25 @@ def test_a_lost_walker_does_not_take_a_leg_pair_where_the_laser_only_ever_saw_so
         assert tracker._update_standing([pair]) == taken
 
 
+def test_a_hidden_walker_is_not_held_by_furniture_the_laser_only_ever_saw():
+    """Traced in the waiting room (development seed 73, person 6 at 110.5 s): a walker hidden
+    for a few scans passed a table leg; static support took it for them and held their track
+    there, slowing to a stop, while they walked on; a new track took them up under a new id.
+    Readings where the laser saw something for minutes, and never saw empty, are the room's:
+    they do not hold a walking track (someone who stops there stands where it was empty)."""
+    import dataclasses
+
+    table = _scan([[2.1, 0.05, 0.03], [2.1, -0.15, 0.03]])  # two table legs beside the walker's prediction
+    for before, held in ((table, False), (_scan([]), True)):
+        tracker = _two_tracks()
+        walker = tracker._tracks[0]
+        assert walker.confirmed and not walker.still
+        for stamp in np.arange(-30.0, -2.0, 1.0):  # half a minute of keyframes before the walker came
+            tracker.places.add(dataclasses.replace(before, stamp=float(stamp)), Pose2D())
+        tracker._support(dataclasses.replace(table, stamp=0.3), Pose2D(), set())
+        assert (walker.last_update == 0.3) == held, held
+
+
 def test_where_someone_stood_furniture_that_was_there_before_them_does_not_take_their_id():
     """Traced in the waiting room (seed 33): a person stood beside a table leg and left; the
     table leg kept their place occupied (never seen empty), so the memory of where they stood
