@@ -574,9 +574,15 @@ class PeopleTracker:
         if furniture:
             self._stood = [e for e in self._stood if e not in furniture]  # by identity (eq=False)
 
-    def _place_history(self, xy: np.ndarray, since: float) -> str:
+    def _place_history(self, xy: np.ndarray, since: float, from_first: bool = True) -> str:
+        """What the place memory saw at ``xy`` (world frame, m) up to ``existence.place_before_s``
+        before ``since`` (s). Without ``from_first``, a place seen occupied in every keyframe
+        since the laser's first scan is called furniture only once that is 10 s of keyframes,
+        as any other place (a crowd standing from the first scan is not the room)."""
         e = self.existence
-        return self.places.history(xy, since - e.place_before_s, e.place_radius_m, self.detector.params.no_return_free_m)
+        rule = {} if from_first else {"min_occupied_from_first_s": np.inf}
+        return self.places.history(xy, since - e.place_before_s, e.place_radius_m, self.detector.params.no_return_free_m,
+                                   **rule)
 
     def _usable(self, pose: Pose2D | None, stamp: float) -> Pose2D | None:
         """The pose, or None when it is not finite (counted; the first one is a warning)."""
@@ -866,8 +872,10 @@ class PeopleTracker:
         with their legs together, one segment the leg model scores low, earns their
         confirmation by staying (``existence.present_lr``), as a confirmed person keeps it.
         A walking track (not still) is not held by readings where the place memory says the
-        laser only ever saw something (``OCCUPIED_ONLY``): a walker hidden beside furniture
-        walks on, and someone who stops stands where it was empty before."""
+        laser only ever saw something for 10 s or more (``OCCUPIED_ONLY``, without the
+        shortcut for places occupied since the first scan: a crowd standing from the start
+        is not the room): a walker hidden beside furniture walks on, and someone who stops
+        stands where it was empty before."""
         idle = [i for i, t in enumerate(self._tracks) if i not in matched and (
             t.confirmed or (t.born_standing and not t.moved and t.existence.walked_or_arrived))]
         if not idle:
@@ -886,7 +894,7 @@ class PeopleTracker:
         for i, z in zip(idle, found):
             t = self._tracks[i]
             if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
-                if not t.still and self._place_history(z, scan.stamp) == PlaceMemory.OCCUPIED_ONLY:
+                if not t.still and self._place_history(z, scan.stamp, from_first=False) == PlaceMemory.OCCUPIED_ONLY:
                     continue  # a walker hidden beside furniture: the readings are the room's, not theirs
                 t.update(z, R, moving=False)
 

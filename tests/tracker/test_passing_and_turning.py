@@ -325,18 +325,20 @@ def test_a_hidden_walker_is_not_held_by_furniture_the_laser_only_ever_saw():
     for a few scans passed a table leg; static support took it for them and held their track
     there, slowing to a stop, while they walked on; a new track took them up under a new id.
     Readings where the laser saw something for minutes, and never saw empty, are the room's:
-    they do not hold a walking track (someone who stops there stands where it was empty)."""
+    they do not hold a walking track (someone who stops there stands where it was empty).
+    Seen occupied for a few seconds since the laser's first scan is not enough: in the
+    30-second crowd that was its members standing from the start (MOTA 80.9 -> 79.8 %)."""
     import dataclasses
 
     table = _scan([[2.1, 0.05, 0.03], [2.1, -0.15, 0.03]])  # two table legs beside the walker's prediction
-    for before, held in ((table, False), (_scan([]), True)):
+    for before, first_s, held in ((table, -30.0, False), (_scan([]), -30.0, True), (table, -5.0, True)):
         tracker = _two_tracks()
         walker = tracker._tracks[0]
         assert walker.confirmed and not walker.still
-        for stamp in np.arange(-30.0, -2.0, 1.0):  # half a minute of keyframes before the walker came
+        for stamp in np.arange(first_s, -2.0, 1.0):  # keyframes from the laser's first scan to before the walker came
             tracker.places.add(dataclasses.replace(before, stamp=float(stamp)), Pose2D())
         tracker._support(dataclasses.replace(table, stamp=0.3), Pose2D(), set())
-        assert (walker.last_update == 0.3) == held, held
+        assert (walker.last_update == 0.3) == held, (first_s, held)
 
 
 def test_where_someone_stood_furniture_that_was_there_before_them_does_not_take_their_id():
