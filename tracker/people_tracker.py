@@ -574,15 +574,9 @@ class PeopleTracker:
         if furniture:
             self._stood = [e for e in self._stood if e not in furniture]  # by identity (eq=False)
 
-    def _place_history(self, xy: np.ndarray, since: float, from_first: bool = True) -> str:
-        """What the place memory saw at ``xy`` (world frame, m) up to ``existence.place_before_s``
-        before ``since`` (s). Without ``from_first``, a place seen occupied in every keyframe
-        since the laser's first scan is called furniture only once that is 10 s of keyframes,
-        as any other place (a crowd standing from the first scan is not the room)."""
+    def _place_history(self, xy: np.ndarray, since: float) -> str:
         e = self.existence
-        rule = {} if from_first else {"min_occupied_from_first_s": np.inf}
-        return self.places.history(xy, since - e.place_before_s, e.place_radius_m, self.detector.params.no_return_free_m,
-                                   **rule)
+        return self.places.history(xy, since - e.place_before_s, e.place_radius_m, self.detector.params.no_return_free_m)
 
     def _usable(self, pose: Pose2D | None, stamp: float) -> Pose2D | None:
         """The pose, or None when it is not finite (counted; the first one is a warning)."""
@@ -891,12 +885,19 @@ class PeopleTracker:
             for k, z in zip(again, self._static_support(places, scan, world)):
                 found[k] = z
         R = np.eye(2) * self.assoc.support_sigma_m ** 2
-        for i, z in zip(idle, found):
-            t = self._tracks[i]
-            if z is not None and np.hypot(*(z - t.moving_position)) <= self.assoc.support_anchor_m:
-                if not t.still and self._place_history(z, scan.stamp, from_first=False) == PlaceMemory.OCCUPIED_ONLY:
-                    continue  # a walker hidden beside furniture: the readings are the room's, not theirs
-                t.update(z, R, moving=False)
+        held = [(i, z) for i, z in zip(idle, found)
+                if z is not None and np.hypot(*(z - self._tracks[i].moving_position)) <= self.assoc.support_anchor_m]
+        walking = [k for k, (i, _) in enumerate(held) if not self._tracks[i].still]
+        if walking:  # one pass over the place memory's keyframes for every walking track
+            e = self.existence
+            room = self.places.histories(np.array([held[k][1] for k in walking]), scan.stamp - e.place_before_s,
+                                         e.place_radius_m, self.detector.params.no_return_free_m,
+                                         min_occupied_from_first_s=np.inf)
+            # a walker hidden beside furniture: the readings are the room's, not theirs
+            furniture = {walking[k] for k, h in enumerate(room) if h == PlaceMemory.OCCUPIED_ONLY}
+            held = [h for k, h in enumerate(held) if k not in furniture]
+        for i, z in held:
+            self._tracks[i].update(z, R, moving=False)
 
     def _walkers_now(self) -> np.ndarray:
         """Where the confirmed tracks that took a moving candidate this scan are (world frame,
