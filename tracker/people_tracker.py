@@ -222,7 +222,7 @@ class PeopleTracker:
         self.existence = existence or ExistenceParams()
         self.places = PlaceMemory(self.existence.place_keyframe_s, self.existence.place_memory_s)
         self._stood: list[StoodPlace] = []
-        self._vanished: list[VanishedWalker] = []  # walkers whose tracks ended unseen, the last SET_OFF_S
+        self._vanished: list[VanishedWalker] = []  # walkers whose tracks ended unseen (see _walked_on_unseen)
         self._legs_world = np.zeros((0, 2))  # this scan's leg candidates (world frame, m) ...
         self._leg_scores = np.zeros(0)  # ... and their leg probabilities
         self._stopping: dict[int, np.ndarray] = {}  # track index -> the candidates it may not take this scan

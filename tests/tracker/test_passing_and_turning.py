@@ -819,8 +819,9 @@ def test_a_walker_whose_track_ended_unseen_gets_their_id_back_walking_on():
     so each scan counted against a walker that should be seen moving, and the track ended
     within a second, its prediction still within 0.1 m of them. A new track took them up
     1-2 s later, under a new id. A walking track born within SET_OFF_S of the old one's
-    last update (and confirmed within tracks.max_tentative_s after), heading the same way, whose first place lies within
-    association.recover_radius_m of where the old one would be by then, takes its id
+    last update (and confirmed within tracks.max_tentative_s after), heading the same way,
+    whose first place lies within association.recover_radius_m of where the old one would
+    be by then, takes its id
     (not while following someone: measured on the development following runs, it gained
     nothing for the followed person and put the target on someone else more often)."""
     from people_tracker.detection.free_space import OCCUPIED, SEEN_THROUGH
