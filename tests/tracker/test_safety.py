@@ -126,23 +126,25 @@ def test_ctrl_c_that_a_library_swallows_still_ends_the_run():
     and puts Python's own back after; where Ctrl-C is ignored it is left ignored."""
     from people_tracker.tracker.cli import _ctrl_c_latch
 
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
-    with _ctrl_c_latch() as interrupted:
-        assert not interrupted()
-        try:  # what a library that drops the exception does
-            os.kill(os.getpid(), signal.SIGINT)
-            time.sleep(0.5)  # the handler runs at the next bytecode
-        except KeyboardInterrupt:
-            pass
-        assert interrupted()
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # started in the background by a shell
+    # Python's own handler, as in a terminal (pytest started in the background by a shell
+    # inherits SIGINT ignored: a clean-clone CI run here failed on that alone)
+    started_with = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
+        with _ctrl_c_latch() as interrupted:
+            assert not interrupted()
+            try:  # what a library that drops the exception does
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.5)  # the handler runs at the next bytecode
+            except KeyboardInterrupt:
+                pass
+            assert interrupted()
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # started in the background by a shell
         with _ctrl_c_latch() as interrupted:
             assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN and not interrupted()
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGINT, started_with)
 
 
 def test_evaluate_warns_when_the_files_come_from_different_recordings(tmp_path):
