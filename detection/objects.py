@@ -90,7 +90,7 @@ def describe_all(first_id: int, beams: list[np.ndarray], points: list[np.ndarray
     # GEOS divides by a side's length, which underflows for objects a few nanometres across
     # (readings of 1e-200 m, say, when a driver's range_min is 0): the rectangle it returns is
     # still right to within rounding, so the floating-point warnings say nothing to a user
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+    with np.errstate(all="ignore"):
         centroids = shapely.centroid(shapely.convex_hull(clouds))
         rects = shapely.minimum_rotated_rectangle(clouds)
     cx, cy = shapely.get_x(centroids), shapely.get_y(centroids)

@@ -574,9 +574,16 @@ class PeopleTracker:
         if furniture:
             self._stood = [e for e in self._stood if e not in furniture]  # by identity (eq=False)
 
-    def _place_history(self, xy: np.ndarray, since: float) -> str:
+    def _place_histories(self, xy: np.ndarray, since: float, **options) -> list[str]:
+        """:meth:`PlaceMemory.histories` of places (world frame, m, shape (k, 2)): the keyframes
+        up to ``existence.place_before_s`` before ``since`` (s), over a disc of
+        ``existence.place_radius_m``; ``options`` as that method takes them."""
         e = self.existence
-        return self.places.history(xy, since - e.place_before_s, e.place_radius_m, self.detector.params.no_return_free_m)
+        return self.places.histories(np.asarray(xy, dtype=float).reshape(-1, 2), since - e.place_before_s,
+                                     e.place_radius_m, self.detector.params.no_return_free_m, **options)
+
+    def _place_history(self, xy: np.ndarray, since: float) -> str:
+        return self._place_histories(xy, since)[0]
 
     def _usable(self, pose: Pose2D | None, stamp: float) -> Pose2D | None:
         """The pose, or None when it is not finite (counted; the first one is a warning)."""
@@ -889,12 +896,10 @@ class PeopleTracker:
                 if z is not None and np.hypot(*(z - self._tracks[i].moving_position)) <= self.assoc.support_anchor_m]
         walking = [k for k, (i, _) in enumerate(held) if not self._tracks[i].still]
         if walking:  # one pass over the place memory's keyframes for every walking track
-            e = self.existence
-            room = self.places.histories(np.array([held[k][1] for k in walking]), scan.stamp - e.place_before_s,
-                                         e.place_radius_m, self.detector.params.no_return_free_m,
+            room = self._place_histories(np.array([held[k][1] for k in walking]), scan.stamp,
                                          min_occupied_from_first_s=np.inf)
             # a walker hidden beside furniture: the readings are the room's, not theirs
-            furniture = {walking[k] for k, h in enumerate(room) if h == PlaceMemory.OCCUPIED_ONLY}
+            furniture = {k for k, h in zip(walking, room) if h == PlaceMemory.OCCUPIED_ONLY}
             held = [h for k, h in enumerate(held) if k not in furniture]
         for i, z in held:
             self._tracks[i].update(z, R, moving=False)
@@ -1038,9 +1043,7 @@ class PeopleTracker:
                 xy = xy[d > self.standing.params.confirm_radius_m]
         if not len(xy):
             return
-        places = self.places.histories(xy, stamp - e.place_before_s, e.place_radius_m,
-                                       self.detector.params.no_return_free_m, viewpoint=view,
-                                       viewpoint_radius_m=e.place_radius_m)
+        places = self._place_histories(xy, stamp, viewpoint=view, viewpoint_radius_m=e.place_radius_m)
         empty = np.array([place == PlaceMemory.EMPTY for place in places])
         if not empty.all():
             rows = np.hstack([xy[~empty], np.broadcast_to(view, (int((~empty).sum()), 2))])
