@@ -231,9 +231,8 @@ class PeopleTracker:
         self._tracks: list[TrackState] = []
         # each track's places in the sensor frame over the selector's trail_s: (stamp s, place m)
         self._trails: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-        # two walking tracks within a stride: since when (s), their distance averaged over
-        # tracks.same_person_after_s (m), as of when (s)
-        self._close_since: dict[tuple[TrackState, TrackState], tuple[float, float, float]] = {}
+        # pairs of walking tracks closer than tracks.min_person_separation_m: since when (s)
+        self._close_since: dict[tuple[TrackState, TrackState], float] = {}
         self._next_id = 1
         self.last: StepResult | None = None
         self.bad_poses = 0  # poses given with a scan that were not finite (the scan was used without)
@@ -1127,12 +1126,9 @@ class PeopleTracker:
         the standing person hides one of them for a moment) is someone passing close by, and
         stays.
         Two walking tracks that close for ``tracks.same_person_after_s`` are one person twice
-        (a track on each leg, or one that slid onto them from a passer-by): closer than
-        ``min_person_separation_m`` on average over that time (exponentially weighted), and
-        within a stride (``pairing.max_leg_separation_m``) of each other throughout, since
-        tracks on a walker's two legs swing apart with the legs now and then. The one that
-        moved more over the last ``tracks.still_after_s`` slid there and goes, unless it is
-        the followed person's."""
+        (a track on each leg, or one that slid onto them from a passer-by): the one whose
+        place is less certain (the larger trace of its position covariance) goes, unless it
+        is the followed person's."""
         sep, after_s = self.track_params.min_person_separation_m, self.track_params.same_person_after_s
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
         close_since, self._close_since = self._close_since, {}
@@ -1141,8 +1137,7 @@ class PeopleTracker:
         xy = np.array([self._tracks[i].position for i in idx])
         d = pairwise_distances(xy, xy)
         out = set()
-        stride = max(sep, self.pairing.max_leg_separation_m)
-        rows, cols = np.nonzero(d < stride)
+        rows, cols = np.nonzero(d < sep)
         upper = rows < cols  # each pair once, in np.triu's (row-major) order
         target = self.selector.target if self.selector is not None else None
         for a, b in zip(rows[upper].tolist(), cols[upper].tolist()):
@@ -1152,18 +1147,11 @@ class PeopleTracker:
             if not (ta.still or tb.still):  # two walking: one person twice once they stay this close
                 if after_s <= 0:
                     continue
-                # two tracks on one walker's two legs swing about them, a stride apart at
-                # most and often farther than sep for a scan or two: their distance averaged
-                # over after_s (exponentially; no scan rate in it) is what stays under sep
-                since, mean, at = close_since.get((ta, tb), (stamp, float(d[a, b]), stamp))
-                mean += (1.0 - math.exp(-(stamp - at) / after_s)) * (float(d[a, b]) - mean)
-                self._close_since[(ta, tb)] = (since, mean, stamp)
-                if stamp - since >= after_s and mean < sep:  # the one that moved more lately slid there
-                    da, db = (float(np.hypot(*(t.position - t.recent_position))) for t in (ta, tb))
-                    goes, stays = (idx[a], idx[b]) if da > db else (idx[b], idx[a])
+                since = self._close_since[(ta, tb)] = close_since.get((ta, tb), stamp)
+                if stamp - since >= after_s:
+                    goes, stays = (idx[a], idx[b]) if np.trace(ta.position_cov) > np.trace(tb.position_cov) \
+                        else (idx[b], idx[a])
                     out.add(stays if self._tracks[goes].track_id == target else goes)
-                continue
-            if d[a, b] >= sep:
                 continue
             if ta.still != tb.still:
                 walker, stander, k = (tb, ta, idx[b]) if ta.still else (ta, tb, idx[a])

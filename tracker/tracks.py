@@ -47,11 +47,10 @@ class TrackParams:
         close to one standing still is that person twice, and the newcomer is deleted; and
         a person standing still takes a moving candidate only this close (setting off).
     same_person_after_s : float
-        Two walking tracks closer than ``min_person_separation_m`` on average over this long,
-        seconds (and within a stride throughout), are one person twice (a track on each of
-        their legs, or one that slid onto them from someone passing): the one that moved more
-        over the last ``still_after_s`` goes. Two people passing close come that near for a
-        moment only. 0: never.
+        Two walking tracks closer than ``min_person_separation_m`` for this long, seconds,
+        are one person twice (a track on each of their legs, or one that slid onto them from
+        someone passing): the one whose place is less certain goes. Two people passing close
+        come that near for a moment only. 0: never.
     unobserved_sensor_speed_mps, unobserved_sensor_turn_radps : float
         How far off the sensor's own motion may be, as speed (m/s) and turn rate (rad/s),
         while nothing measures it: no odometry, and scan matching failed (nothing in range
