@@ -579,8 +579,8 @@ class PeopleTracker:
         up to ``existence.place_before_s`` before ``since`` (s), over a disc of
         ``existence.place_radius_m``; ``options`` as that method takes them."""
         e = self.existence
-        return self.places.histories(np.asarray(xy, dtype=float).reshape(-1, 2), since - e.place_before_s,
-                                     e.place_radius_m, self.detector.params.no_return_free_m, **options)
+        return self.places.histories(xy, since - e.place_before_s, e.place_radius_m,
+                                     self.detector.params.no_return_free_m, **options)
 
     def _place_history(self, xy: np.ndarray, since: float) -> str:
         return self._place_histories(xy, since)[0]
