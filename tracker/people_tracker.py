@@ -1128,7 +1128,9 @@ class PeopleTracker:
         Two walking tracks that close for ``tracks.same_person_after_s`` are one person twice
         (a track on each leg, or one that slid onto them from a passer-by): the one whose
         place is less certain (the larger trace of its position covariance) goes, unless it
-        is the followed person's."""
+        is the followed person's.
+        When the followed person's track goes as the same person twice as one standing
+        still, the one that stays takes their id (:meth:`_heir_of_target`)."""
         sep, after_s = self.track_params.min_person_separation_m, self.track_params.same_person_after_s
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
         close_since, self._close_since = self._close_since, {}
@@ -1160,10 +1162,24 @@ class PeopleTracker:
                            and np.hypot(*walker.velocity) >= PASSING_MPS)
                 if not passing:  # born at their leg (their own leg's track), or sliding onto them
                     out.add(k)
+                    self._heir_of_target(walker, stander, target)
             else:  # the one that moved more over the last still_after_s slid there: it goes
                 da, db = (float(np.hypot(*(t.position - t.recent_position))) for t in (ta, tb))
-                out.add(idx[b] if (da, ta.born) <= (db, tb.born) else idx[a])
+                goes, stays = (tb, ta) if (da, ta.born) <= (db, tb.born) else (ta, tb)
+                out.add(idx[b] if goes is tb else idx[a])
+                self._heir_of_target(goes, stays, target)
         return out
+
+    @staticmethod
+    def _heir_of_target(goes: TrackState, stays: TrackState, target: int | None) -> None:
+        """``goes`` and ``stays`` are one person twice and ``goes`` is deleted: when it holds
+        the followed person's id (``target``), ``stays`` takes it (the two swap ids; the
+        deleted one's is never reported again). Traced outdoors (development seeds 3 and 5,
+        laser ``wide``): the person stopped, a track born standing on them stayed and their
+        walking track went; the selector, its target gone, looks for the person only in the
+        zone ahead, and they stood beside the robot, unmarked, for 8 s."""
+        if target is not None and goes.track_id == target:
+            goes.track_id, stays.track_id = stays.track_id, goes.track_id
 
     def _born_beside(self, t: TrackState, tracks: list[TrackState], stamp: float) -> list[TrackState]:
         """The tracks of ``tracks`` born within ``SET_OFF_S`` before ``stamp`` whose first

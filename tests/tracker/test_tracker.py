@@ -614,6 +614,28 @@ def test_two_walking_tracks_on_one_person_for_a_second_are_one_person_twice():
     assert tracker._duplicates(10.0 + after) == {0}
 
 
+def test_the_followed_persons_track_that_goes_as_one_person_twice_leaves_them_its_id():
+    """Traced outdoors (development seeds 3 and 5, laser wide): the followed person stopped;
+    a track born standing on them and their walking track were one person twice, and the
+    walking one went. The target's id went with it, and the selector, which looks for a lost
+    person only in the zone ahead, left them unmarked beside the robot for 8 s. The track
+    that stays takes the id."""
+    tracker = PeopleTracker.from_config(load_config(), follow="auto")
+    stander, _ = new_track(x=2.0, y=1.0, params=tracker.track_params, standing=True)
+    walker, _ = new_track(x=2.1, y=1.0, params=tracker.track_params)
+    stander.track_id, walker.track_id = 7, 1
+    for t in (stander, walker):
+        t.confirmed = True
+    tracker._tracks, tracker._close_since = [stander, walker], {}
+    assert stander.still and not walker.still
+    tracker.selector.target = 3  # someone else is followed: ids stay
+    assert tracker._duplicates(2.0) == {1}
+    assert (stander.track_id, walker.track_id) == (7, 1)
+    tracker.selector.target = 1  # the walker is the followed person's track: the stander takes the id
+    assert tracker._duplicates(2.0) == {1}
+    assert stander.track_id == 1 and walker.track_id == 7
+
+
 def test_a_walker_born_beyond_a_standing_persons_legs_passes_them_by():
     """Traced in the waiting room (seed 23): someone walking in was first seen 0.69 m from a
     person standing, passed within 0.3 m of them and had their track deleted as the standing
