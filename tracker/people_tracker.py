@@ -1129,7 +1129,7 @@ class PeopleTracker:
         (a track on each leg, or one that slid onto them from a passer-by): the one whose
         place is less certain (the larger trace of its position covariance) goes, unless it
         is the followed person's.
-        When the followed person's track goes as the same person twice as one standing
+        When the followed person's track goes by one of the two rules for a track standing
         still, the one that stays takes their id (:meth:`_heir_of_target`)."""
         sep, after_s = self.track_params.min_person_separation_m, self.track_params.same_person_after_s
         idx = [i for i, t in enumerate(self._tracks) if t.confirmed]
