@@ -1165,8 +1165,8 @@ class PeopleTracker:
                     self._heir_of_target(walker, stander, target)
             else:  # the one that moved more over the last still_after_s slid there: it goes
                 da, db = (float(np.hypot(*(t.position - t.recent_position))) for t in (ta, tb))
-                goes, stays = (tb, ta) if (da, ta.born) <= (db, tb.born) else (ta, tb)
-                out.add(idx[b] if goes is tb else idx[a])
+                goes, stays, k = (tb, ta, idx[b]) if (da, ta.born) <= (db, tb.born) else (ta, tb, idx[a])
+                out.add(k)
                 self._heir_of_target(goes, stays, target)
         return out
 
