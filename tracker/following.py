@@ -11,9 +11,10 @@ track at that place — when exactly one is there; when more than one could be t
 person is reported lost rather than swapped for someone else. An ``auto`` selector (the
 robot follows whoever it locked onto in front of it) gives a lost person's id instead to
 the one person in front of the robot after a moment, if there is exactly one (of several,
-the one clearly walking as the person last walked, by their world-frame velocity; a track
-not confirmed yet beyond the lock zone, where the person could be, counts as one, since
-far away the person's own track is confirmed slowly): a robot
+the one clearly walking as the person last walked, by their world-frame velocity, or else
+the one clearly in the robot's way, straight ahead of it; a track not confirmed yet beyond
+the lock zone, where the person could be, counts as one, since far away the person's own
+track is confirmed slowly): a robot
 following someone has them in front of it, wherever a drifting or turned estimate says
 they went, and the one track near that estimate was more often a passer-by than them. A
 track that walks neither as the person last walked nor as the robot that follows them now
@@ -60,15 +61,24 @@ class TargetSelector:
         the re-lock began (:meth:`looked_for`): the robot may have fallen back. With several
         there, the one walking as the person last walked takes the id, when it is clearly
         them: its world-frame velocity within ``same_velocity_mps`` (m/s) of theirs and every
-        other's more than ``other_velocity_mps`` from it (:meth:`_walking_on`). Only tracks
-        that walk as the person could (:meth:`walks_as_expected`) are looked among: one
-        coming the other way or crossing is not them, and leaves the choice to the others.
+        other's more than ``other_velocity_mps`` from it (:meth:`_walking_on`); else the one
+        in the robot's way, when it clearly is (:meth:`_in_the_way`). Only tracks that walk
+        as the person could (:meth:`walks_as_expected`) are looked among: one coming the
+        other way or crossing is not them, and leaves the choice to the others.
     max_walk_change_mps, sensor_velocity_s : float
         A track re-locked onto walks (world-frame velocity) within ``max_walk_change_mps``
         (m/s) of the person's velocity when last seen, or of the sensor's own velocity over
         the last ``sensor_velocity_s`` seconds (a robot following someone moves as they do,
         turns after them included); else it is someone coming the other way or crossing,
         and the person stays lost. None: no such test.
+    max_sensor_walk_change_mps : float or None
+        ... and never more than this (m/s) from the sensor's own velocity, when that is known
+        (and ``max_walk_change_mps`` is not None): the person's velocity when last seen may
+        be a passer-by's, their track having slid onto someone coming the other way before
+        it broke off, while the robot that follows them still moves as they do. 1.5 m/s
+        lets through someone a quarter turn from the robot's way at walking pace (about
+        1.1 m/s each), or setting off at 1.5 m/s from a robot standing still. None: no such
+        test.
     same_person_m : float
         Reported tracks in the zone ahead all within this distance (m) of the closest of
         them are one person seen twice (a track on each leg), not several people: the
@@ -100,7 +110,8 @@ class TargetSelector:
         (or since they began): someone crossing the robot's way passes its axis. A target
         lost while the lock settles is chosen afresh, as at the first lock: the person
         to follow is the one in the robot's way, and the re-lock (which waits ``relock_s``,
-        and then chooses none of several) is for a person it has learnt.
+        and then takes one of several only when it clearly walks as the person did or is
+        clearly in the robot's way, by this margin too) is for a person it has learnt.
     approach_mps : float
         ``auto``, until the first lock has settled (``settle_s``): a track in the lane
         that came nearer along the sensor's axis faster than this (m/s) over the last
@@ -122,6 +133,7 @@ class TargetSelector:
                  slide_m: float = 0.6, relock_s: float = 1.0, same_person_m: float = 0.35,
                  lane_m: float = 0.75, same_velocity_mps: float = 0.2, other_velocity_mps: float = 1.2,
                  max_walk_change_mps: float | None = 1.0, sensor_velocity_s: float = 0.5,
+                 max_sensor_walk_change_mps: float | None = 1.5,
                  trail_s: float = 1.0, settle_s: float = 2.0, settle_margin_m: float = 0.2,
                  approach_mps: float = 0.5) -> None:
         self.mode = mode
@@ -148,6 +160,7 @@ class TargetSelector:
         self._same_velocity, self._other_velocity = same_velocity_mps, other_velocity_mps
         self.events: list[str] = []
         self._max_walk_change = max_walk_change_mps
+        self._max_sensor_walk_change = max_sensor_walk_change_mps
         self._path_s = sensor_velocity_s
         self._path: deque = deque()  # (stamp s, x m, y m): the sensor's place in the world frame, lately
 
@@ -205,10 +218,15 @@ class TargetSelector:
     def walks_as_expected(self, velocity: np.ndarray | None) -> bool:
         """Whether a track walking at ``velocity`` (world frame, m/s) could be the person: within
         ``max_walk_change_mps`` of how they last walked or of how the sensor that follows them
-        moves now (True when neither, or the velocity, is known)."""
+        moves now, and within ``max_sensor_walk_change_mps`` of the latter (True when neither,
+        or the velocity, is known)."""
         if self._max_walk_change is None or velocity is None:
             return True
-        refs = [r for r in (self.velocity, self.sensor_velocity()) if r is not None]
+        sensor = self.sensor_velocity()
+        if (sensor is not None and self._max_sensor_walk_change is not None
+                and float(np.hypot(*(velocity - sensor))) > self._max_sensor_walk_change):
+            return False
+        refs = [r for r in (self.velocity, sensor) if r is not None]
         return not refs or min(float(np.hypot(*(velocity - r))) for r in refs) <= self._max_walk_change
 
     def _forget_place(self) -> None:
@@ -296,9 +314,12 @@ class TargetSelector:
 
     def reacquire(self, stamp: float, others: dict[int, np.ndarray],
                   velocities: dict[int, np.ndarray] | None = None,
-                  pending: dict[int, np.ndarray] | None = None) -> int | None:
+                  pending: dict[int, np.ndarray] | None = None,
+                  then: dict[int, np.ndarray] | None = None) -> int | None:
         """Which other track (id → sensor-frame place) takes over the missing target's id
-        (``velocities``: id → world-frame velocity, m/s, when known, ``pending`` included).
+        (``velocities``: id → world-frame velocity, m/s, when known, ``pending`` included;
+        ``then``: id → where it was ``trail_s`` ago or where it began, in the sensor frame
+        then, m, when known).
 
         ``pending``: tracks updated this scan but not yet reported (id → sensor-frame place,
         m). ``auto`` counts those beyond the lock zone's range among the ones it looks among,
@@ -323,6 +344,8 @@ class TargetSelector:
             best = self._only_one(looked, everyone)
             if best is None:
                 best = self._walking_on(looked, velocities)
+            if best is None:
+                best = self._in_the_way(looked, everyone, then)
             if best in far:  # not reported yet: the id waits for it
                 best = None
             if best is not None:  # where they are now is learnt afresh
@@ -345,6 +368,27 @@ class TargetSelector:
         if dv[0][0] <= self._same_velocity and dv[1][0] > self._other_velocity:
             return dv[0][1]
         return None
+
+    def _in_the_way(self, candidates: list[int], tracks: dict[int, np.ndarray],
+                    then: dict[int, np.ndarray] | None) -> int | None:
+        """Of several candidate tracks (ids of ``tracks``, id → sensor-frame place, m), the one
+        in the robot's way: in the lane (within ``lane_m`` of the sensor's axis, in the follow
+        zone out to ``lock_range_m``), nearer the axis than every other by ``settle_margin_m``
+        or more, and not crossing it (its offset from the axis changed by no more than that
+        since ``then``, id → place ``trail_s`` ago in the sensor frame then, when given). A
+        robot that follows someone steers to keep them straight ahead of it, as at the first
+        lock; None otherwise."""
+        if len(candidates) < 2:
+            return None
+        off = {tid: self._off_axis(tracks[tid]) for tid in candidates}
+        best = min(candidates, key=lambda tid: (off[tid], tid))
+        if off[best] > self._lane_m or math.hypot(*tracks[best]) > self._lock_range:
+            return None
+        if any(off[tid] < off[best] + self.settle_margin_m for tid in candidates if tid != best):
+            return None
+        if then is not None and best in then and abs(float(tracks[best][1] - then[best][1])) > self.settle_margin_m:
+            return None
+        return best
 
     def in_front(self, tracks: dict[int, np.ndarray], range_m: float | None = None) -> list[int]:
         """The tracks (id → sensor-frame place, m) in the follow zone ahead (out to ``range_m``,

@@ -1353,7 +1353,7 @@ class PeopleTracker:
                 others = [u for u in self._tracks if u.track_id != sel.target and u.reported and u not in unreported]
                 pending = [u for u in self._tracks if u.track_id != sel.target and not u.reported and u.updated_now]
                 new_id = sel.reacquire(stamp, here(others), {u.track_id: u.velocity for u in others + pending},
-                                       here(pending))
+                                       here(pending), {u.track_id: self._trails[u][0][1] for u in others + pending})
                 if new_id is not None:
                     for u in self._tracks:  # the id's old track, if it lives on unreported, is not them
                         if u.track_id == sel.target:

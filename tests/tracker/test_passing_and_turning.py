@@ -146,13 +146,14 @@ def test_a_lost_person_is_not_guessed_among_several_in_front():
     sel.seen(0.0, np.array([2.0, 2.0]))
     sel.yaw = math.pi
     sel.lost(0.2)
-    assert sel.reacquire(1.3, {7: np.array([2.2, 0.1]), 9: np.array([3.0, -0.5])}) is None  # lost, not swapped
+    # both nearly as much in the robot's way (0.1 and 0.25 m off its axis): lost, not swapped
+    assert sel.reacquire(1.3, {7: np.array([2.2, 0.1]), 9: np.array([3.0, -0.25])}) is None
     assert TargetSelector(5).reacquire(1.3, {7: np.array([2.2, 0.1])}) is None  # an id given by the user: never
 
 
 def test_of_several_in_front_the_one_walking_on_as_the_person_walked_takes_their_id():
     walking = np.array([1.0, 0.0])  # m/s, world frame: the person walked on ahead of the robot
-    person, passer_by = np.array([2.0, 0.1]), np.array([1.6, -0.5])  # both in the zone ahead
+    person, passer_by = np.array([2.0, 0.1]), np.array([1.6, -0.2])  # both in the zone ahead, in the robot's way
 
     def relock(person_v, passer_v, seen_v=walking):  # velocities of None: none given
         sel = TargetSelector("auto", same_velocity_mps=0.2, other_velocity_mps=1.2)
@@ -171,6 +172,23 @@ def test_of_several_in_front_the_one_walking_on_as_the_person_walked_takes_their
     assert relock(np.array([1.5, 0.0]), np.array([0.4, 0.7])) is None  # neither walks as the person did
     assert relock(np.array([1.1, 0.1]), np.array([-1.0, 0.3]), seen_v=None) is None  # their walk is not known
     assert relock(None, None) is None  # no velocities given: nobody
+
+
+def test_of_several_in_front_the_one_clearly_in_the_robots_way_takes_the_lost_persons_id():
+    def relock(others, then=None):
+        sel = TargetSelector("auto", lane_m=0.75, settle_margin_m=0.2, lock_range_m=3.5)
+        sel.target = 1
+        sel.seen(0.0, np.array([1.8, 0.0]))  # straight ahead of the robot that follows them
+        sel.lost(0.2)
+        return sel.reacquire(1.3, others, then=then)
+
+    ahead, aside = np.array([1.9, 0.05]), np.array([1.2, 0.6])
+    assert relock({7: ahead, 8: aside}) == 7  # the other is 0.55 m farther off the robot's axis
+    assert relock({7: ahead, 8: np.array([1.2, -0.2])}) is None  # both nearly as much in the way: unsure
+    assert relock({7: np.array([1.9, 0.8]), 8: np.array([1.5, 1.6])}) is None  # nobody in the lane
+    assert relock({7: ahead, 8: aside}, then={7: np.array([1.9, -0.6]), 8: aside}) is None  # crossing its way
+    assert relock({7: ahead, 8: aside}, then={7: np.array([2.3, 0.0]), 8: aside}) == 7  # walking along it
+    assert relock({7: np.array([3.9, 0.0]), 8: aside}) is None  # where they could be, but beyond the lock zone
 
 
 def test_the_one_in_front_is_not_taken_when_they_walk_as_neither_the_person_nor_the_robot():
@@ -192,6 +210,28 @@ def test_the_one_in_front_is_not_taken_when_they_walk_as_neither_the_person_nor_
     assert relock(np.array([0.2, 1.1])) is None  # crossing: neither the person's walk nor the robot's
     assert relock(np.array([0.2, 1.1]), robot_turns=True) == 7  # the person turned, and the robot after them
     assert relock(None) == 7  # no velocities given: the one in front, as before
+
+
+def test_a_track_walking_against_the_robot_that_follows_is_not_the_lost_person():
+    def relock(velocity, max_sensor_walk_change_mps=1.5):
+        """The person's track slid onto someone coming the other way before it broke off at
+        0.6 s: their last velocity is that passer-by's, while the robot that follows them
+        drives on at 1 m/s along x. At 1.7 s one track is in front, walking at ``velocity``."""
+        sel = TargetSelector("auto", max_walk_change_mps=1.0, sensor_velocity_s=0.5,
+                             max_sensor_walk_change_mps=max_sensor_walk_change_mps)
+        sel.target = 1
+        for k in range(18):
+            t = 0.1 * k
+            sel.moved(t, t, 0.0)
+            if k == 5:
+                sel.seen(t, np.array([2.0, 0.0]), np.array([-1.1, 0.0]))
+        sel.lost(0.6)
+        return sel.reacquire(1.7, {7: np.array([1.8, 0.2])}, {7: velocity})
+
+    assert relock(np.array([-1.0, 0.1])) is None  # walks as the passer-by did, against the robot: not them
+    assert relock(np.array([-1.0, 0.1]), max_sensor_walk_change_mps=None) == 7  # without the test
+    assert relock(np.array([1.0, 0.1])) == 7  # walks on as the robot does
+    assert relock(np.array([0.5, 0.8])) == 7  # ... or turning off its way
 
 
 def test_two_tracks_in_front_closer_than_two_people_can_stand_are_one_person():
