@@ -386,9 +386,14 @@ class TargetSelector:
             return None
         if any(off[tid] < off[best] + self.settle_margin_m for tid in candidates if tid != best):
             return None
-        if then is not None and best in then and abs(float(tracks[best][1] - then[best][1])) > self.settle_margin_m:
-            return None
-        return best
+        return None if self._crossing(best, tracks, then) else best
+
+    def _crossing(self, tid: int | None, tracks: dict[int, np.ndarray], then: dict[int, np.ndarray] | None) -> bool:
+        """Whether track ``tid`` (of ``tracks``, id → sensor-frame place, m) is crossing the
+        robot's way: its offset from the sensor's axis changed by more than ``settle_margin_m``
+        since ``then`` (id → place ``trail_s`` ago in the sensor frame then; False when it is
+        not given there)."""
+        return bool(then) and tid in then and abs(float(tracks[tid][1] - then[tid][1])) > self.settle_margin_m
 
     def in_front(self, tracks: dict[int, np.ndarray], range_m: float | None = None) -> list[int]:
         """The tracks (id → sensor-frame place, m) in the follow zone ahead (out to ``range_m``,
@@ -466,8 +471,7 @@ class TargetSelector:
             # (a target gone beside or behind the sensor is in nobody's way) ...
             # ... and stays there (someone crossing the robot's way passes its axis);
             # a target lost, or found passing by, is chosen afresh
-            crossing = bool(then and best in then
-                            and abs(float(reported[best][1] - then[best][1])) > self.settle_margin_m)
+            crossing = self._crossing(best, reported, then)
             afresh = self.lost_since is not None or self.target in self._passing
             if (best is None or best == self.target or crossing
                     or (not afresh and (self.target not in reported or aside[best] + self.settle_margin_m

@@ -1322,6 +1322,9 @@ class PeopleTracker:
         def here(tracks) -> dict[int, np.ndarray]:  # id -> place in the sensor frame (m), as just put in its trail
             return {u.track_id: self._trails[u][-1][1] for u in tracks}
 
+        def before(tracks) -> dict[int, np.ndarray]:  # id -> place in the sensor frame then (m), trail_s ago or where it began
+            return {u.track_id: self._trails[u][0][1] for u in tracks}
+
         if sel.target is not None:
             t = next((u for u in self._tracks if u.track_id == sel.target), None)
             q = here([t])[t.track_id] if t is not None else None
@@ -1353,7 +1356,7 @@ class PeopleTracker:
                 others = [u for u in self._tracks if u.track_id != sel.target and u.reported and u not in unreported]
                 pending = [u for u in self._tracks if u.track_id != sel.target and not u.reported and u.updated_now]
                 new_id = sel.reacquire(stamp, here(others), {u.track_id: u.velocity for u in others + pending},
-                                       here(pending), {u.track_id: self._trails[u][0][1] for u in others + pending})
+                                       here(pending), before(others + pending))
                 if new_id is not None:
                     for u in self._tracks:  # the id's old track, if it lives on unreported, is not them
                         if u.track_id == sel.target:
@@ -1367,8 +1370,7 @@ class PeopleTracker:
                 (s0, q0), (s1, q1) = self._trails[u][0], self._trails[u][-1]
                 if u.track_id in reported and s1 - s0 >= 0.5 * sel.trail_s:
                     closing[u.track_id] = float(q0[0] - q1[0]) / (s1 - s0)
-        target = sel.choose(reported, stamp, {u.track_id: self._trails[u][0][1] for u in self._tracks
-                                              if u.track_id in reported}, closing)
+        target = sel.choose(reported, stamp, before(u for u in self._tracks if u.track_id in reported), closing)
         t = next(u for u in self._tracks if u.track_id == target) if target in reported else None  # ids are unique
         if t is not None and sel.expected(stamp) is None:
             sel.seen(stamp, reported[target], t.velocity, t.position)
