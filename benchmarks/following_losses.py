@@ -24,6 +24,11 @@ made mostly of someone else's readings (the simulator says whose each reading is
 candidate's kind, whose readings, whether the person had a candidate of their own that scan
 (and who took it), and whether they stood still; then the counts. Candidates made of no
 moving object (``receding``) are not judged.
+With ``--losses``, also each time the selector reported its person lost (its event's reason),
+whether the track it gave up was on the person then (the simulator's truth), and how the
+loss ended: their own track found again, the id re-acquired by that same track (a track
+judged off the person that was on them, or came back to them) or by another, on the person
+or not; then the counts by reason.
 The development seeds of the following work are 1 and 2 (``benchmarks/following.py``).
 """
 
@@ -45,11 +50,13 @@ STILL_MPS = 0.1  # m/s: the person stands still when their torso moves slower th
 
 
 def classify(scene: str, laser: str, seed: int, duration: float | None,
-             spells: list[str] | None = None, min_spell_s: float = 1.0, hops: list | None = None) -> Counter:
+             spells: list[str] | None = None, min_spell_s: float = 1.0, hops: list | None = None,
+             losses: list | None = None) -> Counter:
     """The count of the person's visible scans after the first lock in each class; with a
     ``spells`` list, one line is added to it per spell of ``min_spell_s`` or more with the
     target on someone or something else; with a ``hops`` list, one :class:`Hop` per scan
-    where the target's track took someone else's candidate (see the module's text)."""
+    where the target's track took someone else's candidate; with a ``losses`` list, one
+    :class:`Loss` per time the person was reported lost (see the module's text)."""
     source = SimulatedSource(scene, seed=seed, duration=duration, laser=laser)
     tracker = PeopleTracker.from_config(load_config(), follow="auto")
     person, sel = source.sim.target_id, tracker.selector
@@ -59,10 +66,16 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
     # the selector's last 'lost' event)
     marks = []
     on_before, previous = None, None  # the target's id if on the person the scan before; that scan's truth
+    n_events, loss = 0, None  # the selector's events read so far; the loss not ended yet
     for record in source.scans():
+        gave_up = next((u for u in tracker._tracks if u.track_id == sel.target), None)  # the target's track before
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
         truth = source.truths[record.index]
         k = np.flatnonzero((truth.person_id == person) & truth.visible)
+        if losses is not None:
+            for event in sel.events[n_events:]:
+                loss = _loss_event(event, loss, losses, gave_up, tracker, truth, person, record.scan.stamp - (first or record.scan.stamp))
+            n_events = len(sel.events)
         locked |= any(t.target for t in tracks)
         first = record.scan.stamp if first is None else first
         # the reported tracks' places in the sensor frame (m), and the target's id (None without one)
@@ -106,6 +119,67 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
             out["no target, no track near them"] += 1
     if spells is not None:
         spells += _wrong_spells(marks, min_spell_s, first or 0.0)
+    return out
+
+
+@dataclass
+class Loss:
+    """One time the selector reported its person lost, and how that ended."""
+
+    t_s: float  # from the first scan, s
+    why: str  # the reason the 'lost' event gives
+    on_person: bool | None  # the track given up was on the person then (None: it had ended, or they were out of view)
+    track: object  # the track given up (its state; it goes on under a new id when retired)
+    end: str = "not ended"  # found again | re-acquired by the same track | re-acquired by another track | gave up
+    onto_person: bool | None = None  # where it ended: the target on the person (None: out of view, or no target)
+    end_s: float | None = None
+
+    def line(self) -> str:
+        on = {True: "on the person", False: "off the person", None: "ended or out of view"}[self.on_person]
+        onto = {True: "on the person", False: "NOT on the person", None: "person out of view"}[self.onto_person]
+        took = "" if self.end_s is None else f" {self.end_s - self.t_s:.2f} s later"
+        return f"  {self.t_s:7.2f} s  {self.why}; the track given up was {on}; {self.end}{took}, {onto}"
+
+
+def _on_person(state, tracker: PeopleTracker, truth, person: int) -> bool | None:
+    """Whether the track ``state`` lies within ``NEAR_M`` of the person (sensor frame); None
+    when it has ended or the person is out of view."""
+    k = np.flatnonzero((truth.person_id == person) & truth.visible)
+    if state is None or state not in tracker._tracks or not len(k):
+        return None
+    q = tracks_in_sensor_frame([state.report()], tracker.last.pose)[0]
+    return float(np.hypot(*(q - truth.torso_sensor[k[0]]))) <= NEAR_M
+
+
+def _loss_event(event: str, loss: Loss | None, losses: list, gave_up, tracker: PeopleTracker, truth, person: int,
+                t_s: float) -> Loss | None:
+    """Book one selector ``event`` in ``losses``; the loss still open after it (``gave_up``:
+    the target's track before this scan)."""
+    if event.startswith("lost"):
+        why = event[event.find("(") + 1:-1] if "(" in event else "no reason given"
+        loss = Loss(t_s, why, _on_person(gave_up, tracker, truth, person), gave_up)
+        losses.append(loss)
+    elif loss is not None and event.startswith(("re-acquired", "found", "gave up")):
+        now = next((u for u in tracker._tracks if u.track_id == tracker.selector.target), None)
+        loss.end = ("gave up" if event.startswith("gave up") else "found again" if event.startswith("found") else
+                    "re-acquired by the same track" if now is loss.track else "re-acquired by another track")
+        loss.onto_person = None if loss.end == "gave up" else _on_person(now, tracker, truth, person)
+        loss.end_s, loss = t_s, None
+    return loss
+
+
+def loss_counts(losses: list[Loss]) -> list[str]:
+    """The summary lines of ``--losses``: per reason, how often the track given up was on the
+    person, and how the losses ended."""
+    out = [f"times the person was reported lost: {len(losses)}"]
+    for why, n in Counter(x.why for x in losses).most_common():
+        mine = [x for x in losses if x.why == why]
+        ends = Counter(x.end if x.end in ("gave up", "not ended") else
+                       f"{x.end}, {({True: 'on the person', False: 'NOT on the person', None: 'person out of view'})[x.onto_person]}"
+                       for x in mine)
+        out.append(f"  {why}: {n}; the track given up was on the person in {sum(x.on_person is True for x in mine)}, "
+                   f"off them in {sum(x.on_person is False for x in mine)}")
+        out += [f"    {c:4d}  {e}" for e, c in ends.most_common()]
     return out
 
 
@@ -215,7 +289,7 @@ def _wrong_spells(marks: list, min_s: float, t0: float) -> list[str]:
 
 def one_run_arguments(doc: str, scene: str, seed: int, argv=None, listings: bool = False) -> argparse.Namespace:
     """``--scene``, ``--laser``, ``--seed`` and ``--duration`` of one simulated following run
-    (with ``listings``, also ``--spells`` and ``--hops``)."""
+    (with ``listings``, also ``--spells``, ``--hops`` and ``--losses``)."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--scene", default=scene)
     ap.add_argument("--laser", default="wide")
@@ -227,6 +301,9 @@ def one_run_arguments(doc: str, scene: str, seed: int, argv=None, listings: bool
         ap.add_argument("--hops", action="store_true",
                         help="also list each scan where the target's track went from the person onto someone "
                              "else's candidate, and count them")
+        ap.add_argument("--losses", action="store_true",
+                        help="also list each time the person was reported lost: why, whether the track given up "
+                             "was on them, and how it ended; then the counts")
     return ap.parse_args(argv)
 
 
@@ -234,7 +311,8 @@ def main(argv=None) -> int:
     args = one_run_arguments(__doc__, "follow_indoor_crowd", 2, argv, listings=True)
     spells: list[str] | None = [] if args.spells else None
     hops: list[Hop] | None = [] if args.hops else None
-    counts = classify(args.scene, args.laser, args.seed, args.duration, spells, hops=hops)
+    losses: list[Loss] | None = [] if args.losses else None
+    counts = classify(args.scene, args.laser, args.seed, args.duration, spells, hops=hops, losses=losses)
     total = sum(counts.values())
     print(f"{args.scene}, laser {args.laser}, seed {args.seed}: {total} scans with the person visible after the first lock")
     for what, n in sorted(counts.items(), key=lambda kv: -kv[1]):
@@ -247,6 +325,10 @@ def main(argv=None) -> int:
               "(s from the first scan):")
         print("\n".join(h.line() for h in hops) if hops else "  none")
         print("\n".join(hop_counts(hops)))
+    if losses is not None:
+        print("each time the person was reported lost (s from the first scan):")
+        print("\n".join(x.line() for x in losses) if losses else "  none")
+        print("\n".join(loss_counts(losses)))
     return 0
 
 

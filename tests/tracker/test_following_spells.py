@@ -56,3 +56,39 @@ def test_a_simulated_run_lists_the_scans_where_the_persons_track_took_someone_el
         assert 0.0 < h.t_s <= 60.0
         assert h.kind in ("leg", "pair", "blob")
         assert max(h.whose, key=h.whose.get) != 1  # the followed person is the simulator's person 1
+
+
+def test_the_losses_are_counted_by_reason_where_the_track_given_up_was_and_how_they_ended():
+    from following_losses import Loss, loss_counts
+    a, b = object(), object()
+    losses = [Loss(1.0, "slid onto someone", True, a, "re-acquired by the same track", True, 2.07),
+              Loss(5.0, "slid onto someone", False, b, "re-acquired by another track", False, 6.0),
+              Loss(9.0, "track ended", None, None, "re-acquired by another track", True, 10.5),
+              Loss(20.0, "slid onto someone", True, a)]
+    lines = loss_counts(losses)
+    assert lines[0].endswith(": 4")
+    assert lines[1].strip() == "slid onto someone: 3; the track given up was on the person in 2, off them in 1"
+    assert sorted(line.strip() for line in lines[2:5]) == [
+        "1  not ended", "1  re-acquired by another track, NOT on the person", "1  re-acquired by the same track, on the person"]
+    assert lines[5].strip() == "track ended: 1; the track given up was on the person in 0, off them in 0"
+    assert "re-acquired by the same track 1.07 s later, on the person" in losses[0].line()
+    assert "the track given up was ended or out of view" in losses[2].line()
+
+
+def test_a_simulated_run_lists_each_loss_of_the_person_and_its_end():
+    """90 s of a development run: the person is lost (their track ends, or slides off them)
+    and their id is taken up again."""
+    from following_losses import classify
+    losses = []
+    classify("follow_indoor_crowd", "narrow", 1, 90.0, losses=losses)
+    assert losses, "the person was never reported lost"
+    for x in losses:
+        assert 0.0 < x.t_s <= 90.0
+        assert x.why in ("track ended", "track not reported", "slid onto someone", "out of reach",
+                         "coasting, another track where they should be")
+        if x.why == "track ended":
+            assert x.on_person is None  # nothing left to judge
+        if x.end_s is not None:
+            assert x.end_s > x.t_s
+            assert x.end in ("found again", "re-acquired by the same track", "re-acquired by another track", "gave up")
+    assert any(x.end.startswith("re-acquired") and x.onto_person for x in losses)
