@@ -136,9 +136,15 @@ class Loss:
 
     def line(self) -> str:
         on = {True: "on the person", False: "off the person", None: "ended or out of view"}[self.on_person]
-        onto = {True: "on the person", False: "NOT on the person", None: "person out of view"}[self.onto_person]
         took = "" if self.end_s is None else f" {self.end_s - self.t_s:.2f} s later"
-        return f"  {self.t_s:7.2f} s  {self.why}; the track given up was {on}; {self.end}{took}, {onto}"
+        return f"  {self.t_s:7.2f} s  {self.why}; the track given up was {on}; {self.end}{took}{_onto(self)}"
+
+
+def _onto(loss: Loss) -> str:
+    """Where a loss that ended with a target put it ("" for one not ended or given up)."""
+    if loss.end in ("gave up", "not ended"):
+        return ""
+    return ", " + {True: "on the person", False: "NOT on the person", None: "person out of view"}[loss.onto_person]
 
 
 def _on_person(state, tracker: PeopleTracker, truth, person: int) -> bool | None:
@@ -174,9 +180,7 @@ def loss_counts(losses: list[Loss]) -> list[str]:
     out = [f"times the person was reported lost: {len(losses)}"]
     for why, n in Counter(x.why for x in losses).most_common():
         mine = [x for x in losses if x.why == why]
-        ends = Counter(x.end if x.end in ("gave up", "not ended") else
-                       f"{x.end}, {({True: 'on the person', False: 'NOT on the person', None: 'person out of view'})[x.onto_person]}"
-                       for x in mine)
+        ends = Counter(x.end + _onto(x) for x in mine)
         out.append(f"  {why}: {n}; the track given up was on the person in {sum(x.on_person is True for x in mine)}, "
                    f"off them in {sum(x.on_person is False for x in mine)}")
         out += [f"    {c:4d}  {e}" for e, c in ends.most_common()]

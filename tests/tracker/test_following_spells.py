@@ -92,3 +92,9 @@ def test_a_simulated_run_lists_each_loss_of_the_person_and_its_end():
             assert x.end_s > x.t_s
             assert x.end in ("found again", "re-acquired by the same track", "re-acquired by another track", "gave up")
     assert any(x.end.startswith("re-acquired") and x.onto_person for x in losses)
+
+
+def test_a_loss_not_ended_or_given_up_says_nothing_of_where_the_target_went():
+    from following_losses import Loss
+    assert Loss(3.0, "track ended", None, None).line().endswith("not ended")
+    assert Loss(3.0, "track ended", None, None, "gave up", None, 13.0).line().endswith("gave up 10.00 s later")
