@@ -3,6 +3,7 @@
 Usage::
 
     python benchmarks/following_losses.py [--scene follow_indoor_crowd] [--laser wide] [--seed 2] [--duration S]
+        [--spells] [--hops] [--losses]
 
 Runs the default tracker with ``--follow auto`` on one simulated following run and sorts
 every scan where the person is visible, after the first lock, into: the target is on them
