@@ -69,7 +69,8 @@ def classify(scene: str, laser: str, seed: int, duration: float | None,
     on_before, previous = None, None  # the target's id if on the person the scan before; that scan's truth
     n_events, loss = 0, None  # the selector's events read so far; the loss not ended yet
     for record in source.scans():
-        gave_up = next((u for u in tracker._tracks if u.track_id == sel.target), None)  # the target's track before
+        # the target's track before this scan (only --losses asks)
+        gave_up = None if losses is None else next((u for u in tracker._tracks if u.track_id == sel.target), None)
         tracks = tracker.step(record.scan, record.pose, record.pose_last_beam)
         truth = source.truths[record.index]
         k = np.flatnonzero((truth.person_id == person) & truth.visible)
